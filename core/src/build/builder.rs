@@ -1,0 +1,590 @@
+//! The build skeleton: choose axes, bin, sweep, then stop or split. Heuristics are type parameters.
+
+use super::arena::{Bin, BuildArena, PrimRefs, Task};
+use super::config::{BuildConfig, MAX_BINS};
+use crate::bvh::{Bvh, BvhNode};
+use crate::geometry::{Aabb, Triangle};
+use crate::heuristics::{
+    AllAxes, AxisChooser, CostModel, LongestAxis, Sah, SahTermination, Termination,
+};
+use crate::BuildError;
+
+/// What a build produced, besides the BVH.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BuildStats {
+    /// Nodes written.
+    pub nodes: u32,
+    /// Leaves among them.
+    pub leaves: u32,
+    /// Depth of the deepest node.
+    pub max_depth: u32,
+    /// Nodes split by the object-median fallback because the heuristic could not separate them
+    /// (all centroids equal, a zero-measure node) or the depth budget ran short.
+    pub median_splits: u32,
+}
+
+/// A top-down binned builder (Wald 2007) with pluggable axis choice `A`, cost model `C` and
+/// termination rule `T`.
+///
+/// Per node: `A` names the axes to try; the node's centroids are binned along them in one pass;
+/// a prefix and a suffix sweep over the bins price every bin boundary as
+/// `C_trav + C_isect * (m(L) n_L + m(R) n_R) / m(parent)` with `m` from `C`; `T` compares the best
+/// price with the leaf's `C_isect * n`. O(n) work per level, no allocation, no recursion on the call
+/// stack. The depth bound of [`BuildConfig::max_depth`] always holds: when
+/// `depth + ceil(log2 n)` reaches it, or when no binned plane separates a node that must split, the
+/// node is split at its object median instead.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Builder<A = AllAxes, C = Sah, T = SahTermination> {
+    /// Which axes each node tries.
+    pub axes: A,
+    /// The hit measure that prices splits.
+    pub cost: C,
+    /// When a node becomes a leaf.
+    pub termination: T,
+    /// Bins, cost constants and depth bound.
+    pub config: BuildConfig,
+}
+
+impl Builder {
+    /// Binned SAH over all three axes with SAH termination: the state of the art.
+    pub fn sah() -> Self {
+        Self::default()
+    }
+}
+
+impl Builder<LongestAxis> {
+    /// Binned SAH over the longest axis only (LSPH): the thesis's "standard" builder.
+    pub fn lsph() -> Self {
+        Builder {
+            axes: LongestAxis,
+            cost: Sah,
+            termination: SahTermination::default(),
+            config: BuildConfig::default(),
+        }
+    }
+}
+
+/// One side of a split: its bounds, primitive count and (doubled) centroid bounds.
+type Child = (Aabb, u32, Aabb);
+
+/// The best binned split of a node.
+#[derive(Clone, Copy, Debug)]
+struct Split {
+    axis: usize,
+    map: BinMap,
+    /// First bin of the right child.
+    bin: usize,
+    /// `m(L) n_L + m(R) n_R`.
+    weighted: f32,
+}
+
+/// Maps a doubled centroid coordinate to its bin along one axis.
+#[derive(Clone, Copy, Debug)]
+struct BinMap {
+    min: f32,
+    scale: f32,
+    last: f32,
+}
+
+impl BinMap {
+    /// `None` when the centroids have no extent along the axis (no plane can separate them).
+    #[inline]
+    fn new(min: f32, max: f32, bins: u32) -> Option<Self> {
+        let extent = max - min;
+        // The scale is shrunk by a few ulps so the largest centroid maps inside the last bin.
+        let scale = bins as f32 * (1.0 - 4.0 * f32::EPSILON) / extent;
+        (extent > 0.0 && scale.is_finite()).then_some(Self {
+            min,
+            scale,
+            last: (bins - 1) as f32,
+        })
+    }
+
+    #[inline(always)]
+    fn bin(&self, c: f32) -> usize {
+        // `as usize` saturates (NaN to 0), and the clamp keeps rounding inside the bins.
+        ((c - self.min) * self.scale).clamp(0.0, self.last) as usize
+    }
+}
+
+impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
+    /// A builder from its three strategies and its settings.
+    pub fn new(axes: A, cost: C, termination: T, config: BuildConfig) -> Self {
+        Self {
+            axes,
+            cost,
+            termination,
+            config,
+        }
+    }
+
+    /// The same builder with other settings.
+    pub fn with_config(self, config: BuildConfig) -> Self {
+        Self { config, ..self }
+    }
+
+    /// Builds a BVH over `tris` (triangle `i` gets id `i`), allocating its own arena and output.
+    pub fn build(&self, tris: &[Triangle]) -> Result<Bvh, BuildError> {
+        let mut arena = BuildArena::with_capacity(tris.len());
+        arena.load_triangles(tris)?;
+        let mut bvh = Bvh::with_capacity(tris.len());
+        self.build_into(&mut arena, &mut bvh)?;
+        Ok(bvh)
+    }
+
+    /// Builds a BVH over the primitives loaded in `arena`, writing it into `out` (whose previous
+    /// content is replaced). Allocates nothing when `out` was made with
+    /// [`Bvh::with_capacity`] for at least as many primitives; otherwise it grows `out` once,
+    /// before the build starts. An empty arena gives an empty BVH.
+    pub fn build_into(
+        &self,
+        arena: &mut BuildArena,
+        out: &mut Bvh,
+    ) -> Result<BuildStats, BuildError> {
+        self.config.validate()?;
+        let n = arena.len();
+        out.nodes.clear();
+        out.prim_indices.clear();
+        out.max_depth = 0;
+        let mut stats = BuildStats::default();
+        if n == 0 {
+            return Ok(stats);
+        }
+        out.nodes.reserve(2 * n - 1);
+        out.prim_indices.reserve(n);
+
+        out.nodes.push(BvhNode::leaf(arena.bounds, 0, n as u32));
+        arena.tasks.clear();
+        let mut task = Task {
+            node: 0,
+            start: 0,
+            count: n as u32,
+            depth: 0,
+            centroids: arena.centroids,
+        };
+        loop {
+            stats.max_depth = stats.max_depth.max(task.depth);
+            match self.split(
+                arena,
+                &task,
+                &out.nodes[task.node as usize].bounds(),
+                &mut stats,
+            ) {
+                None => stats.leaves += 1,
+                Some((left, right)) => {
+                    let l = out.nodes.len() as u32;
+                    out.nodes[task.node as usize].left_first = l;
+                    out.nodes[task.node as usize].count = 0;
+                    out.nodes.push(BvhNode::leaf(left.0, task.start, left.1));
+                    out.nodes
+                        .push(BvhNode::leaf(right.0, task.start + left.1, right.1));
+                    let depth = task.depth + 1;
+                    arena.tasks.push(Task {
+                        node: l + 1,
+                        start: task.start + left.1,
+                        count: right.1,
+                        depth,
+                        centroids: right.2,
+                    });
+                    task = Task {
+                        node: l,
+                        start: task.start,
+                        count: left.1,
+                        depth,
+                        centroids: left.2,
+                    };
+                    continue;
+                }
+            }
+            match arena.tasks.pop() {
+                Some(next) => task = next,
+                None => break,
+            }
+        }
+        out.prim_indices.extend_from_slice(&arena.refs.ids);
+        out.max_depth = stats.max_depth;
+        stats.nodes = out.nodes.len() as u32;
+        Ok(stats)
+    }
+
+    /// Decides one node: `None` for a leaf, or the two children as (bounds, count, centroid
+    /// bounds) after partitioning the node's slots in place.
+    fn split(
+        &self,
+        arena: &mut BuildArena,
+        task: &Task,
+        bounds: &Aabb,
+        stats: &mut BuildStats,
+    ) -> Option<(Child, Child)> {
+        let count = task.count;
+        if task.depth >= self.config.max_depth || count <= 1 {
+            return None;
+        }
+        if self.termination.must_stop(count, task.depth) {
+            return None;
+        }
+        // The depth budget: a node that could not finish with halving splits alone takes them now.
+        if task.depth + ceil_log2(count) >= self.config.max_depth {
+            stats.median_splits += 1;
+            return Some(median_split(&mut arena.refs, task));
+        }
+        let k = self.config.constants;
+        let parent = self.cost.measure(bounds);
+        let leaf_cost = k.intersection * count as f32;
+        let best = if parent > 0.0 && parent.is_finite() {
+            self.best_split(arena, task, bounds)
+        } else {
+            None
+        };
+        let Some(best) = best else {
+            // No plane separates the centroids, or no ray of the model reaches the node.
+            if self
+                .termination
+                .prefer_leaf(count, leaf_cost, f32::INFINITY)
+            {
+                return None;
+            }
+            stats.median_splits += 1;
+            return Some(median_split(&mut arena.refs, task));
+        };
+        let split_cost = k.traversal + k.intersection * best.weighted / parent;
+        if self.termination.prefer_leaf(count, leaf_cost, split_cost) {
+            return None;
+        }
+        Some(partition(arena, task, &best, self.config.bins))
+    }
+
+    /// Bins the node's centroids along the chosen axes and sweeps for the cheapest boundary.
+    fn best_split(&self, arena: &mut BuildArena, task: &Task, bounds: &Aabb) -> Option<Split> {
+        let nb = self.config.bins as usize;
+        let order = self.axes.order(bounds);
+        let mut maps: [Option<BinMap>; 3] = [None; 3];
+        for (axis, _quality) in order.iter() {
+            maps[axis] = BinMap::new(
+                task.centroids.min[axis],
+                task.centroids.max[axis],
+                self.config.bins,
+            );
+        }
+        if maps.iter().all(Option::is_none) {
+            return None;
+        }
+        for (axis, map) in maps.iter().enumerate() {
+            if map.is_some() {
+                arena.bins[axis][..nb].fill(Bin::EMPTY);
+            }
+        }
+        let refs = &arena.refs;
+        let (start, end) = (task.start as usize, (task.start + task.count) as usize);
+        for i in start..end {
+            let b = refs.bounds(i);
+            let c = b.min + b.max;
+            for (axis, map) in maps.iter().enumerate() {
+                if let Some(map) = map {
+                    let bin = &mut arena.bins[axis][map.bin(c[axis])];
+                    bin.count += 1;
+                    bin.bounds = bin.bounds.union(b);
+                }
+            }
+        }
+        let mut best: Option<Split> = None;
+        for axis in 0..3 {
+            if maps[axis].is_none() {
+                continue;
+            }
+            let bins = &arena.bins[axis][..nb];
+            // Suffix sweep: measure and count of bins[i..].
+            let mut right_m = [0.0f32; MAX_BINS as usize];
+            let mut right_n = [0u32; MAX_BINS as usize];
+            let mut acc = Bin::EMPTY;
+            for i in (1..nb).rev() {
+                acc.bounds = acc.bounds.union(bins[i].bounds);
+                acc.count += bins[i].count;
+                right_m[i] = self.cost.measure(&acc.bounds);
+                right_n[i] = acc.count;
+            }
+            // Prefix sweep: price every boundary.
+            let mut left = Bin::EMPTY;
+            for i in 1..nb {
+                left.bounds = left.bounds.union(bins[i - 1].bounds);
+                left.count += bins[i - 1].count;
+                if left.count == 0 || right_n[i] == 0 {
+                    continue;
+                }
+                let weighted = self.cost.measure(&left.bounds) * left.count as f32
+                    + right_m[i] * right_n[i] as f32;
+                if weighted.is_finite() && best.is_none_or(|b| weighted < b.weighted) {
+                    best = Some(Split {
+                        axis,
+                        map: maps[axis]?,
+                        bin: i,
+                        weighted,
+                    });
+                }
+            }
+        }
+        best
+    }
+}
+
+/// `ceil(log2(n))` for `n >= 1`.
+#[inline]
+fn ceil_log2(n: u32) -> u32 {
+    32 - (n.max(1) - 1).leading_zeros()
+}
+
+/// Partitions the node's slots in place by the split's bin boundary. The child boxes come from
+/// the bins; the children's centroid bounds are gathered as each slot is classified.
+fn partition(arena: &mut BuildArena, task: &Task, split: &Split, bins: u32) -> (Child, Child) {
+    let refs = &mut arena.refs;
+    let axis = split.axis;
+    let (mut i, mut j) = (task.start as usize, (task.start + task.count) as usize);
+    let (mut left_c, mut right_c) = (Aabb::EMPTY, Aabb::EMPTY);
+    while i < j {
+        let c = refs.centroid2(i);
+        if split.map.bin(c[axis]) < split.bin {
+            left_c = left_c.grown(c);
+            i += 1;
+        } else {
+            right_c = right_c.grown(c);
+            j -= 1;
+            refs.swap(i, j);
+        }
+    }
+    let side = &arena.bins[axis];
+    let left_box = side[..split.bin]
+        .iter()
+        .fold(Aabb::EMPTY, |b, bin| b.union(bin.bounds));
+    let right_box = side[split.bin..bins as usize]
+        .iter()
+        .fold(Aabb::EMPTY, |b, bin| b.union(bin.bounds));
+    let n_left = i as u32 - task.start;
+    (
+        (left_box, n_left, left_c),
+        (right_box, task.count - n_left, right_c),
+    )
+}
+
+/// Splits the node's slots at their object median along the widest centroid axis (or in index
+/// order when all centroids coincide), in place and in O(n) expected time. Both halves get at
+/// least one slot, so depth grows by one while the node halves.
+fn median_split(refs: &mut PrimRefs, task: &Task) -> (Child, Child) {
+    let start = task.start as usize;
+    let end = start + task.count as usize;
+    let mid = start + task.count as usize / 2;
+    let axis = task.centroids.largest_axis();
+    if task.centroids.extent()[axis] > 0.0 {
+        select_nth(refs, start, end, mid, axis);
+    }
+    let gather = |from: usize, to: usize| {
+        (from..to).fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), i| {
+            let pb = refs.bounds(i);
+            (b.union(pb), c.grown(pb.min + pb.max))
+        })
+    };
+    let (lb, lc) = gather(start, mid);
+    let (rb, rc) = gather(mid, end);
+    ((lb, (mid - start) as u32, lc), (rb, (end - mid) as u32, rc))
+}
+
+/// Quickselect over slots `[lo, hi)`: afterwards slot `nth` holds the centroid that would be there
+/// in sorted order along `axis`, with no larger one before it and no smaller one after it.
+/// Iterative, with a median-of-three pivot; equal keys are spread over both sides by the Hoare
+/// scheme, so all-equal input still halves.
+fn select_nth(refs: &mut PrimRefs, mut lo: usize, mut hi: usize, nth: usize, axis: usize) {
+    while hi - lo > 1 {
+        if hi - lo == 2 {
+            if refs.centroid2_axis(lo, axis) > refs.centroid2_axis(lo + 1, axis) {
+                refs.swap(lo, lo + 1);
+            }
+            return;
+        }
+        let mid = lo + (hi - lo) / 2;
+        let (a, b, c) = (
+            refs.centroid2_axis(lo, axis),
+            refs.centroid2_axis(mid, axis),
+            refs.centroid2_axis(hi - 1, axis),
+        );
+        let pivot = a.max(b.min(c)).min(b.max(c));
+        // Hoare partition: [lo, j] <= pivot <= [j + 1, hi).
+        let (mut i, mut j) = (lo, hi - 1);
+        loop {
+            while refs.centroid2_axis(i, axis) < pivot {
+                i += 1;
+            }
+            while refs.centroid2_axis(j, axis) > pivot {
+                j -= 1;
+            }
+            if i >= j {
+                break;
+            }
+            refs.swap(i, j);
+            i += 1;
+            j -= 1;
+        }
+        if nth <= j {
+            hi = j + 1;
+        } else {
+            lo = j + 1;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use alloc::vec::Vec;
+
+    use glam::Vec3;
+
+    use super::*;
+    use crate::brute_force;
+    use crate::geometry::Ray;
+    use crate::heuristics::LeafSize;
+
+    /// A xorshift generator: enough for test scenes, and no dependency.
+    struct Xorshift(u64);
+
+    impl Xorshift {
+        fn next_f32(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 40) as f32 / (1u64 << 24) as f32
+        }
+        fn vec3(&mut self, scale: f32) -> Vec3 {
+            Vec3::new(self.next_f32(), self.next_f32(), self.next_f32()) * scale
+        }
+    }
+
+    fn soup(n: usize, seed: u64) -> Vec<Triangle> {
+        let mut rng = Xorshift(seed);
+        (0..n)
+            .map(|_| {
+                let v0 = rng.vec3(10.0);
+                Triangle::new(v0, v0 + rng.vec3(1.0), v0 + rng.vec3(1.0))
+            })
+            .collect()
+    }
+
+    fn check_against_brute_force<A: AxisChooser, C: CostModel, T: Termination>(
+        builder: &Builder<A, C, T>,
+        tris: &[Triangle],
+    ) {
+        let bvh = builder.build(tris).unwrap();
+        bvh.validate(tris.len(), |i| tris[i as usize].bounds())
+            .unwrap();
+        let mut rng = Xorshift(99);
+        for _ in 0..300 {
+            let o = rng.vec3(12.0) - Vec3::ONE;
+            let d = rng.vec3(2.0) - Vec3::ONE;
+            let Ok(ray) = Ray::new(o, d) else { continue };
+            let expect = brute_force::closest_hit(&ray, tris);
+            assert_eq!(bvh.closest_hit(&ray, tris), expect);
+            assert_eq!(bvh.any_hit(&ray, tris), expect.is_some());
+            assert_eq!(
+                bvh.all_hit(&ray, tris).hits,
+                brute_force::hit_count(&ray, tris)
+            );
+        }
+    }
+
+    #[test]
+    fn sah_and_lsph_agree_with_brute_force() {
+        let tris = soup(500, 7);
+        check_against_brute_force(&Builder::sah(), &tris);
+        check_against_brute_force(&Builder::lsph(), &tris);
+        let thesis = Builder::new(
+            AllAxes,
+            Sah,
+            LeafSize { max_leaf: 2 },
+            BuildConfig::default(),
+        );
+        check_against_brute_force(&thesis, &tris);
+    }
+
+    #[test]
+    fn empty_and_single() {
+        let bvh = Builder::sah().build(&[]).unwrap();
+        assert!(bvh.nodes().is_empty());
+        let ray = Ray::new(Vec3::ZERO, Vec3::X).unwrap();
+        assert!(bvh.closest_hit(&ray, &[]).is_none());
+        assert!(!bvh.any_hit(&ray, &[]));
+        let one = soup(1, 3);
+        let bvh = Builder::sah().build(&one).unwrap();
+        assert_eq!(bvh.nodes().len(), 1);
+        bvh.validate(1, |i| one[i as usize].bounds()).unwrap();
+    }
+
+    #[test]
+    fn identical_triangles_split_by_median_within_depth() {
+        let tri = soup(1, 5)[0];
+        let tris = alloc::vec![tri; 1000];
+        let b = Builder::new(
+            AllAxes,
+            Sah,
+            LeafSize { max_leaf: 1 },
+            BuildConfig::default(),
+        );
+        let bvh = b.build(&tris).unwrap();
+        bvh.validate(tris.len(), |i| tris[i as usize].bounds())
+            .unwrap();
+        assert_eq!(bvh.leaf_count(), 1000);
+        assert!(bvh.max_depth() <= 10, "depth {}", bvh.max_depth());
+    }
+
+    #[test]
+    fn geometric_progression_respects_depth_bound() {
+        // Each triangle twice as far as the previous: SAH peels one off per level.
+        let tris: Vec<Triangle> = (0..60)
+            .map(|i| {
+                let x = 1.5f32.powi(i);
+                Triangle::new(
+                    Vec3::new(x, 0.0, 0.0),
+                    Vec3::new(x, 1.0, 0.0),
+                    Vec3::new(x, 0.0, 1.0),
+                )
+            })
+            .collect();
+        for max_depth in [6, 8, 64] {
+            let config = BuildConfig {
+                max_depth,
+                ..BuildConfig::default()
+            };
+            let b = Builder::new(AllAxes, Sah, LeafSize { max_leaf: 1 }, config);
+            let bvh = b.build(&tris).unwrap();
+            bvh.validate(tris.len(), |i| tris[i as usize].bounds())
+                .unwrap();
+            assert!(bvh.max_depth() <= max_depth);
+        }
+    }
+
+    #[test]
+    fn rejects_nan_and_bad_config() {
+        let mut tris = soup(3, 1);
+        tris[1].v2.y = f32::NAN;
+        assert_eq!(
+            Builder::sah().build(&tris),
+            Err(BuildError::InvalidPrimitive { index: 1 })
+        );
+        let bad = Builder::sah().with_config(BuildConfig {
+            bins: 1,
+            ..BuildConfig::default()
+        });
+        assert!(matches!(
+            bad.build(&soup(3, 1)),
+            Err(BuildError::InvalidConfig(_))
+        ));
+    }
+
+    #[test]
+    fn median_selection_orders_around_nth() {
+        let tris = soup(257, 11);
+        let mut arena = BuildArena::with_capacity(tris.len());
+        arena.load_triangles(&tris).unwrap();
+        let n = tris.len();
+        select_nth(&mut arena.refs, 0, n, n / 2, 0);
+        let pivot = arena.refs.centroid2_axis(n / 2, 0);
+        assert!((0..n / 2).all(|i| arena.refs.centroid2_axis(i, 0) <= pivot));
+        assert!((n / 2..n).all(|i| arena.refs.centroid2_axis(i, 0) >= pivot));
+    }
+}

@@ -1,0 +1,14 @@
+//! Top-down binned BVH construction over caller-sized arenas.
+//!
+//! The [`Builder`] is a skeleton: choose axes, bin primitive centroids, sweep the bins to price every
+//! candidate plane, then stop or split and repeat. What "price" and "axis" mean comes from its type
+//! parameters ([`crate::heuristics`]). All memory a build touches lives in a [`BuildArena`] sized up
+//! front, and the output [`crate::bvh::Bvh`] can be pre-sized too, so a build allocates nothing.
+
+mod arena;
+mod builder;
+mod config;
+
+pub use arena::BuildArena;
+pub use builder::{BuildStats, Builder};
+pub use config::{BuildConfig, MAX_BINS};

@@ -1,0 +1,117 @@
+//! Flat binary BVHs: node arrays with adjacent children, a primitive-index array, and the maximum
+//! depth recorded at build time so that traversal stacks are provably large enough.
+
+mod node;
+mod traverse;
+mod validate;
+
+use alloc::vec::Vec;
+
+pub use node::BvhNode;
+pub use traverse::{AllHitStats, Hit, TraversalStats};
+pub use validate::InvariantError;
+
+use crate::geometry::Aabb;
+use crate::heuristics::{CostConstants, CostModel};
+
+/// The deepest a BVH may be: every builder stops splitting at this depth, and the traversals'
+/// fixed stacks hold this many entries. 64 levels cover any input, since the builder switches to
+/// median splits (which halve the node) before the heuristic could exhaust the budget, and
+/// `log2(u32::MAX) = 32`.
+pub const MAX_DEPTH: u32 = 64;
+
+/// A binary BVH over primitives identified by `u32` ids (for triangles, their index in the
+/// scene's triangle array).
+///
+/// Only the builders make one, so its invariants hold by construction and the traversals can rely
+/// on them: children in range and adjacent, depth at most [`MAX_DEPTH`], every leaf's run inside
+/// [`Bvh::prim_indices`]. [`Bvh::validate`] checks them all.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Bvh {
+    pub(crate) nodes: Vec<BvhNode>,
+    pub(crate) prim_indices: Vec<u32>,
+    pub(crate) max_depth: u32,
+}
+
+impl Bvh {
+    /// An empty BVH with room for a build over `prims` primitives (at most `2 prims - 1` nodes), so
+    /// that [`crate::build::Builder::build_into`] does not allocate.
+    pub fn with_capacity(prims: usize) -> Self {
+        Self {
+            nodes: Vec::with_capacity((2 * prims).saturating_sub(1).max(1)),
+            prim_indices: Vec::with_capacity(prims),
+            max_depth: 0,
+        }
+    }
+
+    /// Nodes, root first, children adjacent; an empty BVH has no nodes.
+    #[inline]
+    pub fn nodes(&self) -> &[BvhNode] {
+        &self.nodes
+    }
+
+    /// Primitive ids in leaf order: a leaf refers to a contiguous run of this array.
+    #[inline]
+    pub fn prim_indices(&self) -> &[u32] {
+        &self.prim_indices
+    }
+
+    /// Depth of the deepest node (the root has depth 0), at most [`MAX_DEPTH`].
+    #[inline]
+    pub fn max_depth(&self) -> u32 {
+        self.max_depth
+    }
+
+    /// The primitive ids of a leaf (empty for an inner node).
+    #[inline]
+    pub fn leaf_prims(&self, node: &BvhNode) -> &[u32] {
+        let first = node.left_first as usize;
+        self.prim_indices
+            .get(first..first + node.count as usize)
+            .unwrap_or(&[])
+    }
+
+    /// True when the BVH holds no primitive.
+    pub fn is_empty(&self) -> bool {
+        self.prim_indices.is_empty()
+    }
+
+    /// The root's box ([`Aabb::EMPTY`] for an empty BVH).
+    pub fn bounds(&self) -> Aabb {
+        self.nodes.first().map_or(Aabb::EMPTY, BvhNode::bounds)
+    }
+
+    /// Number of leaves.
+    pub fn leaf_count(&self) -> usize {
+        self.nodes.iter().filter(|n| n.is_leaf()).count()
+    }
+
+    /// Bytes held by the node and index arrays.
+    pub fn memory_bytes(&self) -> usize {
+        self.nodes.len() * core::mem::size_of::<BvhNode>() + self.prim_indices.len() * 4
+    }
+
+    /// The expected cost of a ray that hits the root, under the hit measure `model`:
+    /// `sum over inner nodes of C_trav * m(n) / m(root) + sum over leaves of C_isect * count *
+    /// m(leaf) / m(root)`. With [`crate::heuristics::Sah`] this is the SAH cost. Zero for an empty
+    /// BVH or a root of zero measure.
+    pub fn estimated_cost(&self, model: &impl CostModel, k: CostConstants) -> f32 {
+        let root = model.measure(&self.bounds());
+        if self.nodes.is_empty() || root <= 0.0 {
+            return 0.0;
+        }
+        let total: f64 = self
+            .nodes
+            .iter()
+            .map(|n| {
+                let m = f64::from(model.measure(&n.bounds()));
+                if n.is_leaf() {
+                    m * f64::from(k.intersection) * f64::from(n.count)
+                } else {
+                    m * f64::from(k.traversal)
+                }
+            })
+            .sum();
+        (total / f64::from(root)) as f32
+    }
+}

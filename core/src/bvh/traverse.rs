@@ -1,0 +1,296 @@
+//! Traversal of a binary BVH: closest hit, any hit and the all-hit cost, each over a fixed stack.
+
+use super::{Bvh, BvhNode, MAX_DEPTH};
+use crate::geometry::{Ray, Triangle};
+use crate::heuristics::CostConstants;
+
+/// The closest intersection along a ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// Id of the triangle hit (its index in the scene's triangle array).
+    pub triangle: u32,
+    /// Barycentric weight of the triangle's `v1`.
+    pub u: f32,
+    /// Barycentric weight of the triangle's `v2`.
+    pub v: f32,
+}
+
+impl Hit {
+    /// True when `self` is closer than `other`; equal distances go to the lower triangle id, so
+    /// every traversal order (and the brute-force oracle) picks the same triangle.
+    #[inline]
+    pub fn is_closer_than(&self, other: &Hit) -> bool {
+        self.t < other.t || (self.t == other.t && self.triangle < other.triangle)
+    }
+}
+
+/// What one closest-hit or any-hit query did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TraversalStats {
+    /// Inner nodes visited (each tests both child boxes).
+    pub inner_nodes: u32,
+    /// Leaves visited.
+    pub leaves: u32,
+    /// Ray/triangle tests.
+    pub triangles: u32,
+}
+
+impl TraversalStats {
+    /// `C_trav * inner nodes + C_isect * triangles`.
+    #[inline]
+    pub fn cost(&self, k: CostConstants) -> f32 {
+        k.traversal * self.inner_nodes as f32 + k.intersection * self.triangles as f32
+    }
+}
+
+/// What the all-hit walk touched: every node whose box the ray segment touches, with no early exit.
+/// This is what SAH and PAH estimate, and what the thesis called the real cost.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AllHitStats {
+    /// Inner nodes whose box the segment touches.
+    pub inner_nodes: u32,
+    /// Leaves whose box the segment touches.
+    pub leaves: u32,
+    /// Triangles in those leaves.
+    pub triangles: u32,
+    /// How many of those triangles the segment hits.
+    pub hits: u32,
+}
+
+impl AllHitStats {
+    /// `C_trav * inner nodes + C_isect * triangles`.
+    #[inline]
+    pub fn cost(&self, k: CostConstants) -> f32 {
+        k.traversal * self.inner_nodes as f32 + k.intersection * self.triangles as f32
+    }
+}
+
+/// A traversal stack with room for one entry per level plus one, which the builder's depth bound
+/// guarantees is enough: every entry is the pending sibling of a node on the current root path,
+/// plus at most the one child about to be popped.
+const STACK_SIZE: usize = MAX_DEPTH as usize + 1;
+
+struct Stack<T: Copy> {
+    items: [T; STACK_SIZE],
+    len: usize,
+}
+
+impl<T: Copy> Stack<T> {
+    #[inline]
+    fn new(fill: T) -> Self {
+        Self {
+            items: [fill; STACK_SIZE],
+            len: 0,
+        }
+    }
+    #[inline]
+    fn push(&mut self, item: T) {
+        self.items[self.len] = item;
+        self.len += 1;
+    }
+    #[inline]
+    fn pop(&mut self) -> Option<T> {
+        self.len = self.len.checked_sub(1)?;
+        Some(self.items[self.len])
+    }
+}
+
+#[inline]
+fn test_leaf(
+    bvh: &Bvh,
+    node: &BvhNode,
+    ray: &Ray,
+    tris: &[Triangle],
+    best: &mut Option<Hit>,
+    stats: &mut TraversalStats,
+) {
+    stats.leaves += 1;
+    let first = node.left_first as usize;
+    for &id in &bvh.prim_indices[first..first + node.count as usize] {
+        let Some(tri) = tris.get(id as usize) else {
+            continue;
+        };
+        stats.triangles += 1;
+        let t_max = best.map_or(ray.t_max, |h| h.t);
+        if let Some(h) = tri.intersect(ray, t_max) {
+            let hit = Hit {
+                t: h.t,
+                triangle: id,
+                u: h.u,
+                v: h.v,
+            };
+            if best.is_none_or(|b| hit.is_closer_than(&b)) {
+                *best = Some(hit);
+            }
+        }
+    }
+}
+
+impl Bvh {
+    /// The closest hit on `[ray.t_min, ray.t_max]`, or `None`. `tris` are the triangles the BVH
+    /// was built over, indexed by primitive id (ids missing from `tris` are skipped).
+    #[inline]
+    pub fn closest_hit(&self, ray: &Ray, tris: &[Triangle]) -> Option<Hit> {
+        self.closest_hit_with_stats(ray, tris, &mut TraversalStats::default())
+    }
+
+    /// [`Bvh::closest_hit`], adding what it did to `stats`. Ordered: at each inner node the nearer
+    /// child is visited first and the farther one is skipped once a hit closer than its entry is
+    /// known.
+    pub fn closest_hit_with_stats(
+        &self,
+        ray: &Ray,
+        tris: &[Triangle],
+        stats: &mut TraversalStats,
+    ) -> Option<Hit> {
+        let root = self.nodes.first()?;
+        root.bounds().intersect(ray, ray.t_max)?;
+        let mut best: Option<Hit> = None;
+        let mut stack = Stack::new((0u32, 0.0f32));
+        let mut index = 0u32;
+        loop {
+            let node = &self.nodes[index as usize];
+            if node.is_leaf() {
+                test_leaf(self, node, ray, tris, &mut best, stats);
+            } else {
+                stats.inner_nodes += 1;
+                let t_max = best.map_or(ray.t_max, |h| h.t);
+                let l = node.left_first;
+                let tl = self.nodes[l as usize].bounds().intersect(ray, t_max);
+                let tr = self.nodes[l as usize + 1].bounds().intersect(ray, t_max);
+                match (tl, tr) {
+                    (Some(a), Some(b)) => {
+                        let (near, far, t_far) = if a <= b { (l, l + 1, b) } else { (l + 1, l, a) };
+                        stack.push((far, t_far));
+                        index = near;
+                        continue;
+                    }
+                    (Some(_), None) => {
+                        index = l;
+                        continue;
+                    }
+                    (None, Some(_)) => {
+                        index = l + 1;
+                        continue;
+                    }
+                    (None, None) => {}
+                }
+            }
+            // Pop the next subtree that can still hold a closer hit.
+            loop {
+                let Some((next, t_entry)) = stack.pop() else {
+                    return best;
+                };
+                if best.is_none_or(|b| t_entry <= b.t) {
+                    index = next;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// True when any triangle is hit on `[ray.t_min, ray.t_max]`: the shadow-ray query. Stops at
+    /// the first hit found.
+    #[inline]
+    pub fn any_hit(&self, ray: &Ray, tris: &[Triangle]) -> bool {
+        self.any_hit_with_stats(ray, tris, &mut TraversalStats::default())
+    }
+
+    /// [`Bvh::any_hit`], adding what it did to `stats`.
+    pub fn any_hit_with_stats(
+        &self,
+        ray: &Ray,
+        tris: &[Triangle],
+        stats: &mut TraversalStats,
+    ) -> bool {
+        let Some(root) = self.nodes.first() else {
+            return false;
+        };
+        if root.bounds().intersect(ray, ray.t_max).is_none() {
+            return false;
+        }
+        let mut stack = Stack::new(0u32);
+        stack.push(0);
+        while let Some(index) = stack.pop() {
+            let node = &self.nodes[index as usize];
+            if node.is_leaf() {
+                stats.leaves += 1;
+                let first = node.left_first as usize;
+                for &id in &self.prim_indices[first..first + node.count as usize] {
+                    let Some(tri) = tris.get(id as usize) else {
+                        continue;
+                    };
+                    stats.triangles += 1;
+                    if tri.intersect(ray, ray.t_max).is_some() {
+                        return true;
+                    }
+                }
+            } else {
+                stats.inner_nodes += 1;
+                let l = node.left_first;
+                // Push the right child first so the left one is visited next; any hit needs no
+                // ordering, only a bounded stack (one pending sibling per level).
+                if self.nodes[l as usize + 1]
+                    .bounds()
+                    .intersect(ray, ray.t_max)
+                    .is_some()
+                {
+                    stack.push(l + 1);
+                }
+                if self.nodes[l as usize]
+                    .bounds()
+                    .intersect(ray, ray.t_max)
+                    .is_some()
+                {
+                    stack.push(l);
+                }
+            }
+        }
+        false
+    }
+
+    /// The all-hit walk: every node whose box the segment `[ray.t_min, ray.t_max]` touches and
+    /// every triangle in those leaves, with no early exit.
+    pub fn all_hit(&self, ray: &Ray, tris: &[Triangle]) -> AllHitStats {
+        let mut stats = AllHitStats::default();
+        let Some(root) = self.nodes.first() else {
+            return stats;
+        };
+        if root.bounds().intersect(ray, ray.t_max).is_none() {
+            return stats;
+        }
+        let mut stack = Stack::new(0u32);
+        stack.push(0);
+        while let Some(index) = stack.pop() {
+            let node = &self.nodes[index as usize];
+            if node.is_leaf() {
+                stats.leaves += 1;
+                let first = node.left_first as usize;
+                for &id in &self.prim_indices[first..first + node.count as usize] {
+                    stats.triangles += 1;
+                    if tris
+                        .get(id as usize)
+                        .is_some_and(|t| t.intersect(ray, ray.t_max).is_some())
+                    {
+                        stats.hits += 1;
+                    }
+                }
+            } else {
+                stats.inner_nodes += 1;
+                let l = node.left_first;
+                for child in [l + 1, l] {
+                    if self.nodes[child as usize]
+                        .bounds()
+                        .intersect(ray, ray.t_max)
+                        .is_some()
+                    {
+                        stack.push(child);
+                    }
+                }
+            }
+        }
+        stats
+    }
+}

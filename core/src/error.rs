@@ -1,0 +1,37 @@
+//! Errors of BVH construction.
+
+use core::fmt;
+
+/// Why a build could not run. Every input the builder rejects gets one of these, never a panic.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BuildError {
+    /// A primitive's bounds have a NaN or infinite coordinate (or are empty).
+    InvalidPrimitive {
+        /// Index of the primitive, as given to the arena.
+        index: u32,
+    },
+    /// More primitives than the arena was sized for.
+    ArenaFull {
+        /// The arena's capacity in primitives.
+        capacity: usize,
+    },
+    /// More primitives than `u32` indices can address.
+    TooManyPrimitives,
+    /// A configuration value is out of range.
+    InvalidConfig(&'static str),
+}
+
+impl fmt::Display for BuildError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            BuildError::InvalidPrimitive { index } => {
+                write!(f, "primitive {index} has a NaN or infinite coordinate")
+            }
+            BuildError::ArenaFull { capacity } => {
+                write!(f, "build arena is full (capacity {capacity} primitives)")
+            }
+            BuildError::TooManyPrimitives => f.write_str("more than 2^32 - 1 primitives"),
+            BuildError::InvalidConfig(why) => write!(f, "invalid build configuration: {why}"),
+        }
+    }
+}

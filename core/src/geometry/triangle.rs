@@ -1,0 +1,160 @@
+//! Triangles and the Moller-Trumbore ray/triangle test.
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+use super::{Aabb, Ray};
+
+/// A triangle given by its three vertices.
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+#[repr(C)]
+pub struct Triangle {
+    /// First vertex; barycentric `u` and `v` weigh `v1` and `v2` against it.
+    pub v0: Vec3,
+    /// Second vertex.
+    pub v1: Vec3,
+    /// Third vertex.
+    pub v2: Vec3,
+}
+
+static_assertions::assert_eq_size!(Triangle, [f32; 9]);
+
+/// A ray/triangle intersection: the ray parameter and the barycentrics of `v1` and `v2`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleHit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// Barycentric weight of `v1`.
+    pub u: f32,
+    /// Barycentric weight of `v2`.
+    pub v: f32,
+}
+
+impl Triangle {
+    /// A triangle from three vertices.
+    #[inline]
+    pub const fn new(v0: Vec3, v1: Vec3, v2: Vec3) -> Self {
+        Self { v0, v1, v2 }
+    }
+
+    /// The bounding box of the three vertices.
+    #[inline]
+    pub fn bounds(&self) -> Aabb {
+        Aabb::new(
+            self.v0.min(self.v1).min(self.v2),
+            self.v0.max(self.v1).max(self.v2),
+        )
+    }
+
+    /// The centroid `(v0 + v1 + v2) / 3`.
+    #[inline]
+    pub fn centroid(&self) -> Vec3 {
+        (self.v0 + self.v1 + self.v2) * (1.0 / 3.0)
+    }
+
+    /// The triangle's area.
+    #[inline]
+    pub fn area(&self) -> f32 {
+        0.5 * (self.v1 - self.v0).cross(self.v2 - self.v0).length()
+    }
+
+    /// True when every vertex coordinate is finite.
+    #[inline]
+    pub fn is_finite(&self) -> bool {
+        self.v0.is_finite() && self.v1.is_finite() && self.v2.is_finite()
+    }
+
+    /// Moller-Trumbore intersection with the segment `[ray.t_min, t_max]`.
+    ///
+    /// Policy, shared by the BVH traversals and the brute-force oracle so both give the same answer:
+    /// - both faces are hit (no back-face culling);
+    /// - edges and vertices belong to the triangle (`u >= 0`, `v >= 0`, `u + v <= 1`), so a ray
+    ///   through a shared edge hits both neighbours and the closest-hit tie rule picks one;
+    /// - the segment is closed: hits at exactly `t_min` or `t_max` count;
+    /// - degenerate triangles (zero area, so a zero determinant) and rays in the triangle's plane
+    ///   never hit; every comparison rejects NaN, so overflow cannot produce a hit either.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<TriangleHit> {
+        let e1 = self.v1 - self.v0;
+        let e2 = self.v2 - self.v0;
+        let p = ray.dir.cross(e2);
+        let det = e1.dot(p);
+        if det == 0.0 {
+            return None;
+        }
+        let inv_det = 1.0 / det;
+        let s = ray.origin - self.v0;
+        let u = s.dot(p) * inv_det;
+        if !(0.0..=1.0).contains(&u) {
+            return None;
+        }
+        let q = s.cross(e1);
+        let v = ray.dir.dot(q) * inv_det;
+        if !(v >= 0.0 && u + v <= 1.0) {
+            return None;
+        }
+        let t = e2.dot(q) * inv_det;
+        (t >= ray.t_min && t <= t_max).then_some(TriangleHit { t, u, v })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri() -> Triangle {
+        Triangle::new(
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, 1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        )
+    }
+
+    #[test]
+    fn hit_with_barycentrics() {
+        let r = Ray::new(Vec3::new(0.25, 0.5, 0.0), Vec3::Z).unwrap();
+        let h = tri().intersect(&r, f32::INFINITY).unwrap();
+        assert!((h.t - 1.0).abs() < 1e-6);
+        assert!((h.u - 0.25).abs() < 1e-6);
+        assert!((h.v - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn back_face_and_edges_hit() {
+        let r = Ray::new(Vec3::new(0.25, 0.25, 2.0), -Vec3::Z).unwrap();
+        assert!(tri().intersect(&r, f32::INFINITY).is_some());
+        let r = Ray::new(Vec3::new(0.5, 0.0, 0.0), Vec3::Z).unwrap();
+        assert!(tri().intersect(&r, f32::INFINITY).is_some(), "edge");
+        let r = Ray::new(Vec3::new(0.0, 0.0, 0.0), Vec3::Z).unwrap();
+        assert!(tri().intersect(&r, f32::INFINITY).is_some(), "vertex");
+    }
+
+    #[test]
+    fn misses() {
+        let r = Ray::new(Vec3::new(0.75, 0.75, 0.0), Vec3::Z).unwrap();
+        assert!(tri().intersect(&r, f32::INFINITY).is_none(), "outside");
+        let r = Ray::new(Vec3::new(0.25, 0.25, 0.0), Vec3::Z).unwrap();
+        assert!(tri().intersect(&r, 0.5).is_none(), "beyond t_max");
+        let r = Ray::new(Vec3::new(0.25, 0.25, 2.0), Vec3::Z).unwrap();
+        assert!(tri().intersect(&r, f32::INFINITY).is_none(), "behind");
+        let r = Ray::new(Vec3::new(-1.0, 0.25, 1.0), Vec3::X).unwrap();
+        assert!(tri().intersect(&r, f32::INFINITY).is_none(), "in plane");
+    }
+
+    #[test]
+    fn degenerate_triangles_never_hit() {
+        let line = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::X * 2.0);
+        let point = Triangle::new(Vec3::ONE, Vec3::ONE, Vec3::ONE);
+        for d in [Vec3::Y, Vec3::Z, Vec3::new(1.0, 1.0, 1.0)] {
+            let r = Ray::new(Vec3::new(0.5, -1.0, -1.0), d).unwrap();
+            assert!(line.intersect(&r, f32::INFINITY).is_none());
+            assert!(point.intersect(&r, f32::INFINITY).is_none());
+        }
+    }
+
+    #[test]
+    fn segment_is_closed() {
+        let r = Ray::segment(Vec3::new(0.25, 0.25, 0.0), Vec3::Z, 1.0, 1.0).unwrap();
+        assert!(tri().intersect(&r, r.t_max).is_some());
+    }
+}

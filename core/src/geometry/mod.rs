@@ -1,9 +1,18 @@
-//! Geometric primitives: boxes, rays and triangles, with the intersection tests the BVH needs.
+//! Geometric primitives: boxes, rays, triangles, oriented boxes and frustums, with the
+//! intersection and separating-axis tests the BVHs and influence areas need.
 
 mod aabb;
+mod convex;
+mod frame;
+mod frustum;
+mod obb;
 mod ray;
 mod triangle;
 
 pub use aabb::Aabb;
+pub use convex::{Plane, Polytope};
+pub use frame::Frame;
+pub use frustum::Frustum;
+pub use obb::Obb;
 pub use ray::{Ray, RayError};
 pub use triangle::{Triangle, TriangleHit};

@@ -27,6 +27,8 @@ pub mod bvh;
 pub mod error;
 pub mod geometry;
 pub mod heuristics;
+pub mod influence;
+pub mod random;
 
 pub use error::BuildError;
 pub use glam::Vec3;

@@ -6,6 +6,7 @@ mod convex;
 mod frame;
 mod frustum;
 mod obb;
+mod polygon;
 mod ray;
 mod triangle;
 
@@ -14,5 +15,6 @@ pub use convex::{Plane, Polytope};
 pub use frame::Frame;
 pub use frustum::Frustum;
 pub use obb::Obb;
+pub use polygon::{ConvexPolygon, MAX_POLY};
 pub use ray::{Ray, RayError};
 pub use triangle::{Triangle, TriangleHit};

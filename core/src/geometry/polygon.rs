@@ -1,0 +1,196 @@
+//! Small convex polygons in fixed arrays: hulls of projected points, clipping to a rectangle,
+//! planar area and the solid angle of an image-plane polygon. No allocation: they run inside the
+//! builder's sweeps.
+
+use glam::{Vec2, Vec3};
+
+/// Most vertices a polygon here can hold: a clipped box silhouette has at most 14 hull points
+/// (8 corners and 6 near-plane cuts), and clipping by a rectangle adds at most 4.
+pub const MAX_POLY: usize = 20;
+
+/// A convex polygon, counter-clockwise, in a fixed array.
+#[derive(Clone, Copy, Debug)]
+pub struct ConvexPolygon {
+    points: [Vec2; MAX_POLY],
+    len: usize,
+}
+
+impl ConvexPolygon {
+    /// The convex hull of `points` (Andrew's monotone chain, counter-clockwise). At most
+    /// [`MAX_POLY`] points are read.
+    pub fn hull(points: &[Vec2]) -> Self {
+        let mut sorted = [Vec2::ZERO; MAX_POLY];
+        let n = points.len().min(MAX_POLY);
+        sorted[..n].copy_from_slice(&points[..n]);
+        let sorted = &mut sorted[..n];
+        sorted.sort_unstable_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+        let mut out = ConvexPolygon {
+            points: [Vec2::ZERO; MAX_POLY],
+            len: 0,
+        };
+        if n < 3 {
+            return out;
+        }
+        let cross = |o: Vec2, a: Vec2, b: Vec2| (a - o).perp_dot(b - o);
+        // Lower hull, then upper hull; `hull` holds up to 2n points transiently.
+        let mut hull = [Vec2::ZERO; 2 * MAX_POLY];
+        let mut k = 0;
+        for &p in sorted.iter() {
+            while k >= 2 && cross(hull[k - 2], hull[k - 1], p) <= 0.0 {
+                k -= 1;
+            }
+            hull[k] = p;
+            k += 1;
+        }
+        let lower = k + 1;
+        for &p in sorted.iter().rev().skip(1) {
+            while k >= lower && cross(hull[k - 2], hull[k - 1], p) <= 0.0 {
+                k -= 1;
+            }
+            hull[k] = p;
+            k += 1;
+        }
+        let len = (k - 1).min(MAX_POLY);
+        out.points[..len].copy_from_slice(&hull[..len]);
+        out.len = len;
+        out
+    }
+
+    /// The vertices.
+    pub fn points(&self) -> &[Vec2] {
+        &self.points[..self.len]
+    }
+
+    /// Shoelace area (zero for fewer than three vertices).
+    pub fn area(&self) -> f32 {
+        let p = self.points();
+        if p.len() < 3 {
+            return 0.0;
+        }
+        let mut twice = 0.0;
+        for i in 0..p.len() {
+            twice += p[i].perp_dot(p[(i + 1) % p.len()]);
+        }
+        0.5 * twice.abs()
+    }
+
+    /// The axis-aligned bounds `(min, max)` of the vertices.
+    pub fn bounds(&self) -> (Vec2, Vec2) {
+        self.points().iter().fold(
+            (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        )
+    }
+
+    /// The polygon clipped to the rectangle `[lo, hi]` (Sutherland-Hodgman, one edge at a time).
+    pub fn clip_to_rect(&self, lo: Vec2, hi: Vec2) -> Self {
+        let mut poly = *self;
+        // Each edge keeps points with `sign * p[axis] <= sign * bound`.
+        for (axis, bound, sign) in [
+            (0, hi.x, 1.0),
+            (0, lo.x, -1.0),
+            (1, hi.y, 1.0),
+            (1, lo.y, -1.0),
+        ] {
+            poly = poly.clip_half(axis, bound, sign);
+            if poly.len < 3 {
+                break;
+            }
+        }
+        poly
+    }
+
+    fn clip_half(&self, axis: usize, bound: f32, sign: f32) -> Self {
+        let mut out = ConvexPolygon {
+            points: [Vec2::ZERO; MAX_POLY],
+            len: 0,
+        };
+        let p = self.points();
+        let inside = |v: Vec2| sign * v[axis] <= sign * bound;
+        for i in 0..p.len() {
+            let (a, b) = (p[i], p[(i + 1) % p.len()]);
+            let (ia, ib) = (inside(a), inside(b));
+            if ia && out.len < MAX_POLY {
+                out.points[out.len] = a;
+                out.len += 1;
+            }
+            if ia != ib && out.len < MAX_POLY {
+                let t = (bound - a[axis]) / (b[axis] - a[axis]);
+                let mut q = a + (b - a) * t;
+                q[axis] = bound;
+                out.points[out.len] = q;
+                out.len += 1;
+            }
+        }
+        out
+    }
+
+    /// The solid angle that this polygon, lying on the image plane `z = 1` of an eye at the
+    /// origin, subtends: a triangle fan summed with the formula of Van Oosterom and Strackee (1983),
+    /// `tan(omega / 2) = |a . (b x c)| / (abc + (a . b) c + (a . c) b + (b . c) a)`.
+    pub fn solid_angle_on_image_plane(&self) -> f32 {
+        let p = self.points();
+        if p.len() < 3 {
+            return 0.0;
+        }
+        let lift = |v: Vec2| Vec3::new(v.x, v.y, 1.0);
+        let a = lift(p[0]);
+        let la = a.length();
+        let mut total = 0.0;
+        for i in 1..p.len() - 1 {
+            let (b, c) = (lift(p[i]), lift(p[i + 1]));
+            let (lb, lc) = (b.length(), c.length());
+            let num = a.dot(b.cross(c)).abs();
+            let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+            total += 2.0 * libm::atan2f(num, den);
+        }
+        total
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hull_of_square_with_inner_points() {
+        let pts = [
+            Vec2::new(0.0, 0.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(0.5, 0.5),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(0.0, 1.0),
+            Vec2::new(0.2, 0.7),
+        ];
+        let h = ConvexPolygon::hull(&pts);
+        assert_eq!(h.points().len(), 4);
+        assert!((h.area() - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn clip_square_by_rect() {
+        let h = ConvexPolygon::hull(&[
+            Vec2::new(-1.0, -1.0),
+            Vec2::new(1.0, -1.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(-1.0, 1.0),
+        ]);
+        let c = h.clip_to_rect(Vec2::new(0.0, -0.5), Vec2::new(3.0, 0.5));
+        assert!((c.area() - 1.0).abs() < 1e-6);
+        let none = h.clip_to_rect(Vec2::new(2.0, 2.0), Vec2::new(3.0, 3.0));
+        assert_eq!(none.area(), 0.0);
+    }
+
+    #[test]
+    fn solid_angle_of_cube_face() {
+        // A face of a cube seen from its centre covers 4 pi / 6.
+        let h = ConvexPolygon::hull(&[
+            Vec2::new(-1.0, -1.0),
+            Vec2::new(1.0, -1.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(-1.0, 1.0),
+        ]);
+        let expect = 4.0 * core::f32::consts::PI / 6.0;
+        assert!((h.solid_angle_on_image_plane() - expect).abs() < 1e-5);
+    }
+}

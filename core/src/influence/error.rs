@@ -1,0 +1,59 @@
+//! Errors of influence-area construction.
+
+use core::fmt;
+
+/// Why an influence area could not be made. Each names the offending key as `experiments.toml`
+/// spells it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AreaError {
+    /// A value is NaN or infinite.
+    NotFinite(&'static str),
+    /// A length that must be positive is zero or negative.
+    NotPositive(&'static str),
+    /// A direction is the zero vector.
+    ZeroDirection(&'static str),
+    /// A field of view is not strictly between 0 and 180 degrees.
+    FieldOfView(&'static str),
+    /// `near` is negative or not below `far`.
+    NearFar,
+    /// The affinity tolerance is not within `[0, 180)` degrees.
+    Tolerance,
+}
+
+impl fmt::Display for AreaError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            AreaError::NotFinite(key) => write!(f, "`{key}` must be finite (got NaN or infinity)"),
+            AreaError::NotPositive(key) => write!(f, "`{key}` must be positive"),
+            AreaError::ZeroDirection(key) => write!(f, "`{key}` must not be the zero vector"),
+            AreaError::FieldOfView(key) => {
+                write!(f, "`{key}` must be strictly between 0 and 180 degrees")
+            }
+            AreaError::NearFar => f.write_str("`near` must be >= 0 and below `far`"),
+            AreaError::Tolerance => {
+                f.write_str("the affinity tolerance must be within [0, 180) degrees")
+            }
+        }
+    }
+}
+
+/// Checks that every component is finite.
+pub(crate) fn finite3(v: glam::Vec3, key: &'static str) -> Result<glam::Vec3, AreaError> {
+    v.is_finite().then_some(v).ok_or(AreaError::NotFinite(key))
+}
+
+/// Checks that a length is finite and positive.
+pub(crate) fn positive(x: f32, key: &'static str) -> Result<f32, AreaError> {
+    if !x.is_finite() {
+        return Err(AreaError::NotFinite(key));
+    }
+    (x > 0.0).then_some(x).ok_or(AreaError::NotPositive(key))
+}
+
+/// The cosine of an affinity tolerance in degrees.
+pub(crate) fn cos_tolerance(deg: f32) -> Result<f32, AreaError> {
+    if !(0.0..180.0).contains(&deg) {
+        return Err(AreaError::Tolerance);
+    }
+    Ok(libm::cosf(deg.to_radians()))
+}

@@ -1,7 +1,7 @@
 //! The build skeleton: choose axes, bin, sweep, then stop or split. Heuristics are type parameters.
 
 use super::arena::{Bin, BuildArena, PrimRefs, Task};
-use super::config::{BuildConfig, MAX_BINS};
+use super::config::{BinSpace, BuildConfig, CutEvaluation, MAX_BINS};
 use crate::bvh::{Bvh, BvhNode};
 use crate::geometry::{Aabb, Triangle};
 use crate::heuristics::{
@@ -59,7 +59,10 @@ impl Builder<LongestAxis> {
             axes: LongestAxis,
             cost: Sah,
             termination: SahTermination::default(),
-            config: BuildConfig::default(),
+            config: BuildConfig {
+                cut: CutEvaluation::FirstAxis,
+                ..BuildConfig::default()
+            },
         }
     }
 }
@@ -67,15 +70,34 @@ impl Builder<LongestAxis> {
 /// One side of a split: its bounds, primitive count and (doubled) centroid bounds.
 type Child = (Aabb, u32, Aabb);
 
-/// The best binned split of a node.
+/// A candidate split at a bin boundary, with what pricing it under any cost model needs.
 #[derive(Clone, Copy, Debug)]
 struct Split {
     axis: usize,
     map: BinMap,
     /// First bin of the right child.
     bin: usize,
-    /// `m(L) n_L + m(R) n_R`.
+    left: Aabb,
+    right: Aabb,
+    n_left: u32,
+    n_right: u32,
+    /// `m(L) n_L + m(R) n_R` under the model that chose the split.
     weighted: f32,
+}
+
+impl Split {
+    /// `m(L) n_L + m(R) n_R` under `model`.
+    #[inline]
+    fn weighted_under(&self, model: &impl CostModel) -> f32 {
+        model.measure(&self.left) * self.n_left as f32
+            + model.measure(&self.right) * self.n_right as f32
+    }
+
+    /// The thesis's cut ratio `(m(L) + m(R)) / m(parent)`.
+    #[inline]
+    fn ratio_under(&self, model: &impl CostModel, parent: f32) -> f32 {
+        (model.measure(&self.left) + model.measure(&self.right)) / parent
+    }
 }
 
 /// Maps a doubled centroid coordinate to its bin along one axis.
@@ -87,7 +109,7 @@ struct BinMap {
 }
 
 impl BinMap {
-    /// `None` when the centroids have no extent along the axis (no plane can separate them).
+    /// `None` when the range has no extent (no plane can separate the centroids).
     #[inline]
     fn new(min: f32, max: f32, bins: u32) -> Option<Self> {
         let extent = max - min;
@@ -123,6 +145,16 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         Self { config, ..self }
     }
 
+    /// The same builder with another termination rule.
+    pub fn with_termination<T2: Termination>(self, termination: T2) -> Builder<A, C, T2> {
+        Builder {
+            axes: self.axes,
+            cost: self.cost,
+            termination,
+            config: self.config,
+        }
+    }
+
     /// Builds a BVH over `tris` (triangle `i` gets id `i`), allocating its own arena and output.
     pub fn build(&self, tris: &[Triangle]) -> Result<Bvh, BuildError> {
         let mut arena = BuildArena::with_capacity(tris.len());
@@ -131,7 +163,6 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         self.build_into(&mut arena, &mut bvh)?;
         Ok(bvh)
     }
-
     /// Builds a BVH over the primitives loaded in `arena`, writing it into `out` (whose previous
     /// content is replaced). Allocates nothing when `out` was made with
     /// [`Bvh::with_capacity`] for at least as many primitives; otherwise it grows `out` once,
@@ -207,8 +238,8 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         Ok(stats)
     }
 
-    /// Decides one node: `None` for a leaf, or the two children as (bounds, count, centroid
-    /// bounds) after partitioning the node's slots in place.
+    /// Decides one node: `None` for a leaf, or the two children after partitioning the node's
+    /// slots in place.
     fn split(
         &self,
         arena: &mut BuildArena,
@@ -228,16 +259,23 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             stats.median_splits += 1;
             return Some(median_split(&mut arena.refs, task));
         }
-        let k = self.config.constants;
         let parent = self.cost.measure(bounds);
-        let leaf_cost = k.intersection * count as f32;
-        let best = if parent > 0.0 && parent.is_finite() {
-            self.best_split(arena, task, bounds)
+        let chosen = if parent > 0.0 && parent.is_finite() {
+            self.choose(&self.cost, parent, arena, task, bounds)
+                .map(|s| (s, s.weighted_under(&self.cost) / parent))
         } else {
-            None
+            // No modelled ray reaches this node (a PAH node outside the light window): SAH, the
+            // uniform-ray model, still orders its subtree sensibly for every other ray.
+            let parent = Sah.measure(bounds);
+            (parent > 0.0 && parent.is_finite())
+                .then(|| self.choose(&Sah, parent, arena, task, bounds))
+                .flatten()
+                .map(|s| (s, s.weighted / parent))
         };
-        let Some(best) = best else {
-            // No plane separates the centroids, or no ray of the model reaches the node.
+        let k = self.config.constants;
+        let leaf_cost = k.intersection * count as f32;
+        let Some((best, relative)) = chosen else {
+            // No plane separates the centroids.
             if self
                 .termination
                 .prefer_leaf(count, leaf_cost, f32::INFINITY)
@@ -247,36 +285,101 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             stats.median_splits += 1;
             return Some(median_split(&mut arena.refs, task));
         };
-        let split_cost = k.traversal + k.intersection * best.weighted / parent;
+        let split_cost = k.traversal + k.intersection * relative;
         if self.termination.prefer_leaf(count, leaf_cost, split_cost) {
             return None;
         }
-        Some(partition(arena, task, &best, self.config.bins))
+        Some(partition(arena, task, &best))
     }
 
-    /// Bins the node's centroids along the chosen axes and sweeps for the cheapest boundary.
-    fn best_split(&self, arena: &mut BuildArena, task: &Task, bounds: &Aabb) -> Option<Split> {
-        let nb = self.config.bins as usize;
+    /// Bins the node along the axes the cut evaluation needs, then applies it with `model`.
+    fn choose<M: CostModel>(
+        &self,
+        model: &M,
+        parent: f32,
+        arena: &mut BuildArena,
+        task: &Task,
+        bounds: &Aabb,
+    ) -> Option<Split> {
         let order = self.axes.order(bounds);
-        let mut maps: [Option<BinMap>; 3] = [None; 3];
-        for (axis, _quality) in order.iter() {
-            maps[axis] = BinMap::new(
-                task.centroids.min[axis],
-                task.centroids.max[axis],
-                self.config.bins,
-            );
+        let first = order.iter().next()?.0;
+        let mut binned = [false; 3];
+        match self.config.cut {
+            CutEvaluation::BestOfAxes => order.iter().for_each(|(a, _)| binned[a] = true),
+            CutEvaluation::FirstAxis => binned[first] = true,
+            // The fallback needs the longest axis whatever the chooser said.
+            CutEvaluation::Thesis(_) => binned = [true; 3],
         }
-        if maps.iter().all(Option::is_none) {
-            return None;
+        let maps = self.bin(arena, task, bounds, binned);
+        let nb = self.config.bins;
+        let arena = &*arena;
+        match self.config.cut {
+            CutEvaluation::BestOfAxes => order
+                .iter()
+                .filter_map(|(axis, _)| sweep_axis(arena, axis, maps[axis]?, nb, model))
+                .min_by(|a, b| a.weighted.total_cmp(&b.weighted)),
+            CutEvaluation::FirstAxis => sweep_axis(arena, first, maps[first]?, nb, model),
+            CutEvaluation::Thesis(cut) => {
+                let mut best: Option<Split> = None;
+                for (i, (axis, quality)) in order.iter().enumerate() {
+                    if i > 0 && quality < cut.quality_threshold {
+                        break;
+                    }
+                    let candidate = maps[axis].and_then(|m| sweep_axis(arena, axis, m, nb, model));
+                    if let Some(s) = candidate {
+                        if best.is_none_or(|b| s.weighted < b.weighted) {
+                            best = Some(s);
+                        }
+                    }
+                    if best.is_some_and(|b| b.ratio_under(model, parent) <= cut.excellent_ratio) {
+                        return best;
+                    }
+                }
+                match best {
+                    Some(b) if b.ratio_under(model, parent) <= cut.acceptable_ratio => Some(b),
+                    // Not even acceptable: SAH on the longest axis, the thesis's fallback.
+                    _ => {
+                        let axis = bounds.largest_axis();
+                        maps[axis]
+                            .and_then(|m| sweep_axis(arena, axis, m, nb, &Sah))
+                            .or(best)
+                    }
+                }
+            }
         }
-        for (axis, map) in maps.iter().enumerate() {
-            if map.is_some() {
+    }
+
+    /// Bins the node's primitives along the `axes` flagged, in one pass over its slots. Returns
+    /// the bin map of each binned axis (`None` where no plane can separate the centroids).
+    fn bin(
+        &self,
+        arena: &mut BuildArena,
+        task: &Task,
+        bounds: &Aabb,
+        axes: [bool; 3],
+    ) -> [Option<BinMap>; 3] {
+        let nb = self.config.bins as usize;
+        let maps: [Option<BinMap>; 3] = core::array::from_fn(|axis| {
+            if !axes[axis] {
+                return None;
+            }
+            let (lo, hi) = match self.config.bin_space {
+                BinSpace::Centroids => (task.centroids.min[axis], task.centroids.max[axis]),
+                // Doubled like the centroids they classify.
+                BinSpace::NodeBox => (2.0 * bounds.min[axis], 2.0 * bounds.max[axis]),
+            };
+            // A node box with extent but coincident centroids cannot be split by any plane.
+            (task.centroids.max[axis] > task.centroids.min[axis])
+                .then(|| BinMap::new(lo, hi, self.config.bins))
+                .flatten()
+        });
+        for axis in 0..3 {
+            if maps[axis].is_some() {
                 arena.bins[axis][..nb].fill(Bin::EMPTY);
             }
         }
         let refs = &arena.refs;
-        let (start, end) = (task.start as usize, (task.start + task.count) as usize);
-        for i in start..end {
+        for i in task.start as usize..(task.start + task.count) as usize {
             let b = refs.bounds(i);
             let c = b.min + b.max;
             for (axis, map) in maps.iter().enumerate() {
@@ -287,44 +390,56 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                 }
             }
         }
-        let mut best: Option<Split> = None;
-        for axis in 0..3 {
-            if maps[axis].is_none() {
-                continue;
-            }
-            let bins = &arena.bins[axis][..nb];
-            // Suffix sweep: measure and count of bins[i..].
-            let mut right_m = [0.0f32; MAX_BINS as usize];
-            let mut right_n = [0u32; MAX_BINS as usize];
-            let mut acc = Bin::EMPTY;
-            for i in (1..nb).rev() {
-                acc.bounds = acc.bounds.union(bins[i].bounds);
-                acc.count += bins[i].count;
-                right_m[i] = self.cost.measure(&acc.bounds);
-                right_n[i] = acc.count;
-            }
-            // Prefix sweep: price every boundary.
-            let mut left = Bin::EMPTY;
-            for i in 1..nb {
-                left.bounds = left.bounds.union(bins[i - 1].bounds);
-                left.count += bins[i - 1].count;
-                if left.count == 0 || right_n[i] == 0 {
-                    continue;
-                }
-                let weighted = self.cost.measure(&left.bounds) * left.count as f32
-                    + right_m[i] * right_n[i] as f32;
-                if weighted.is_finite() && best.is_none_or(|b| weighted < b.weighted) {
-                    best = Some(Split {
-                        axis,
-                        map: maps[axis]?,
-                        bin: i,
-                        weighted,
-                    });
-                }
-            }
-        }
-        best
+        maps
     }
+}
+
+/// The cheapest boundary of one binned axis under `model`: a suffix sweep stores the right
+/// sides' measures and counts, a prefix sweep prices every boundary. O(bins).
+fn sweep_axis<M: CostModel>(
+    arena: &BuildArena,
+    axis: usize,
+    map: BinMap,
+    bins: u32,
+    model: &M,
+) -> Option<Split> {
+    let bins = &arena.bins[axis][..bins as usize];
+    let nb = bins.len();
+    let mut right_box = [Aabb::EMPTY; MAX_BINS as usize];
+    let mut right_m = [0.0f32; MAX_BINS as usize];
+    let mut right_n = [0u32; MAX_BINS as usize];
+    let mut acc = Bin::EMPTY;
+    for i in (1..nb).rev() {
+        acc.bounds = acc.bounds.union(bins[i].bounds);
+        acc.count += bins[i].count;
+        right_box[i] = acc.bounds;
+        right_m[i] = model.measure(&acc.bounds);
+        right_n[i] = acc.count;
+    }
+    let mut best: Option<Split> = None;
+    let mut left = Bin::EMPTY;
+    for i in 1..nb {
+        left.bounds = left.bounds.union(bins[i - 1].bounds);
+        left.count += bins[i - 1].count;
+        if left.count == 0 || right_n[i] == 0 {
+            continue;
+        }
+        let weighted =
+            model.measure(&left.bounds) * left.count as f32 + right_m[i] * right_n[i] as f32;
+        if weighted.is_finite() && best.is_none_or(|b| weighted < b.weighted) {
+            best = Some(Split {
+                axis,
+                map,
+                bin: i,
+                left: left.bounds,
+                right: right_box[i],
+                n_left: left.count,
+                n_right: right_n[i],
+                weighted,
+            });
+        }
+    }
+    best
 }
 
 /// `ceil(log2(n))` for `n >= 1`.
@@ -335,7 +450,7 @@ fn ceil_log2(n: u32) -> u32 {
 
 /// Partitions the node's slots in place by the split's bin boundary. The child boxes come from
 /// the bins; the children's centroid bounds are gathered as each slot is classified.
-fn partition(arena: &mut BuildArena, task: &Task, split: &Split, bins: u32) -> (Child, Child) {
+fn partition(arena: &mut BuildArena, task: &Task, split: &Split) -> (Child, Child) {
     let refs = &mut arena.refs;
     let axis = split.axis;
     let (mut i, mut j) = (task.start as usize, (task.start + task.count) as usize);
@@ -351,17 +466,10 @@ fn partition(arena: &mut BuildArena, task: &Task, split: &Split, bins: u32) -> (
             refs.swap(i, j);
         }
     }
-    let side = &arena.bins[axis];
-    let left_box = side[..split.bin]
-        .iter()
-        .fold(Aabb::EMPTY, |b, bin| b.union(bin.bounds));
-    let right_box = side[split.bin..bins as usize]
-        .iter()
-        .fold(Aabb::EMPTY, |b, bin| b.union(bin.bounds));
-    let n_left = i as u32 - task.start;
+    debug_assert_eq!(i as u32 - task.start, split.n_left);
     (
-        (left_box, n_left, left_c),
-        (right_box, task.count - n_left, right_c),
+        (split.left, split.n_left, left_c),
+        (split.right, split.n_right, right_c),
     )
 }
 

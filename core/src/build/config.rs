@@ -7,6 +7,57 @@ use crate::BuildError;
 /// The most bins a sweep may use; bins live in fixed arrays, so this bounds the arena's size.
 pub const MAX_BINS: u32 = 64;
 
+/// Where the candidate planes of a node lie.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BinSpace {
+    /// Uniformly over the bounds of the node's primitive centroids (Wald 2007): no empty end bins.
+    #[default]
+    Centroids,
+    /// Uniformly over the node's box, as the thesis placed its 40 candidate planes.
+    NodeBox,
+}
+
+/// The thesis's cut evaluation: how picky the builder is before accepting a split.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThesisCut {
+    /// Stop trying axes once `(m(L) + m(R)) / m(parent)` is at most this (thesis: 0.9).
+    pub excellent_ratio: f32,
+    /// When the next axis is of too low a quality, accept the best split so far if its ratio is at
+    /// most this (thesis: 1.3); otherwise fall back to SAH on the longest axis.
+    pub acceptable_ratio: f32,
+    /// Axes after the first are tried only while their quality is at least this (thesis: 0.4
+    /// for SPFH, 0.99 for LSPH).
+    pub quality_threshold: f32,
+}
+
+impl ThesisCut {
+    /// The thesis's values for a chooser with the given quality threshold.
+    pub const fn with_threshold(quality_threshold: f32) -> Self {
+        Self {
+            excellent_ratio: 0.9,
+            acceptable_ratio: 1.3,
+            quality_threshold,
+        }
+    }
+
+    /// The thesis's values for SPFH (threshold 0.4).
+    pub const SPFH: ThesisCut = ThesisCut::with_threshold(0.4);
+    /// The thesis's values for LSPH (threshold 0.99).
+    pub const LSPH: ThesisCut = ThesisCut::with_threshold(0.99);
+}
+
+/// Which of the chooser's axes a node evaluates, and which split it keeps.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum CutEvaluation {
+    /// Evaluate every axis the chooser names and keep the cheapest split.
+    #[default]
+    BestOfAxes,
+    /// Evaluate the chooser's first axis only.
+    FirstAxis,
+    /// The thesis's cut evaluation: axes in quality order, early acceptance, SAH fallback.
+    Thesis(ThesisCut),
+}
+
 /// Settings of the build skeleton.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BuildConfig {
@@ -16,6 +67,10 @@ pub struct BuildConfig {
     pub constants: CostConstants,
     /// Hard depth bound, 1 to [`MAX_DEPTH`]: a node at this depth is a leaf whatever its size.
     pub max_depth: u32,
+    /// Which axes a node evaluates and which split it keeps.
+    pub cut: CutEvaluation,
+    /// Where the candidate planes lie.
+    pub bin_space: BinSpace,
 }
 
 impl Default for BuildConfig {
@@ -24,6 +79,8 @@ impl Default for BuildConfig {
             bins: 16,
             constants: CostConstants::default(),
             max_depth: MAX_DEPTH,
+            cut: CutEvaluation::BestOfAxes,
+            bin_space: BinSpace::Centroids,
         }
     }
 }
@@ -38,6 +95,14 @@ impl BuildConfig {
             return Err(BuildError::InvalidConfig(
                 "max_depth must be between 1 and 64",
             ));
+        }
+        if let CutEvaluation::Thesis(c) = self.cut {
+            let ok = |x: f32| x.is_finite() && x >= 0.0;
+            if !(ok(c.excellent_ratio) && ok(c.acceptable_ratio) && ok(c.quality_threshold)) {
+                return Err(BuildError::InvalidConfig(
+                    "cut ratios and thresholds must be finite and >= 0",
+                ));
+            }
         }
         let k = self.constants;
         if !(k.traversal.is_finite() && k.traversal >= 0.0)

@@ -11,4 +11,4 @@ mod config;
 
 pub use arena::BuildArena;
 pub use builder::{BuildStats, Builder};
-pub use config::{BuildConfig, MAX_BINS};
+pub use config::{BinSpace, BuildConfig, CutEvaluation, ThesisCut, MAX_BINS};

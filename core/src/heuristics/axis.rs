@@ -65,15 +65,37 @@ impl AxisChooser for AllAxes {
     }
 }
 
-/// The longest splitting plane heuristic (LSPH): split across the node's longest axis only, the
-/// thesis's "standard" builder.
+/// The longest splitting plane heuristic (LSPH): axes by decreasing extent, each rated by its
+/// extent over the longest one. With [`crate::build::CutEvaluation::FirstAxis`] only the longest
+/// is tried; with the thesis's cut evaluation (threshold 0.99) the next one only when it is
+/// nearly as long.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct LongestAxis;
 
 impl AxisChooser for LongestAxis {
     #[inline]
     fn order(&self, node: &Aabb) -> AxisOrder {
-        AxisOrder::new(&[(node.largest_axis(), 1.0)])
+        let e = node.extent();
+        let longest = e.max_element();
+        let quality = |k: usize| if longest > 0.0 { e[k] / longest } else { 1.0 };
+        let mut axes = [(0, quality(0)), (1, quality(1)), (2, quality(2))];
+        sort_by_quality(&mut axes);
+        AxisOrder::new(&axes)
+    }
+}
+
+/// Sorts three (axis, quality) pairs by decreasing quality; ties keep the lower axis first.
+#[inline]
+pub(crate) fn sort_by_quality(axes: &mut [(usize, f32); 3]) {
+    // A stable three-element insertion sort: no allocation, NaN qualities sink to the end.
+    for i in 1..3 {
+        let mut j = i;
+        while j > 0
+            && (axes[j].1 > axes[j - 1].1 || (axes[j - 1].1.is_nan() && !axes[j].1.is_nan()))
+        {
+            axes.swap(j, j - 1);
+            j -= 1;
+        }
     }
 }
 
@@ -85,8 +107,8 @@ mod tests {
     #[test]
     fn longest_axis_picks_largest_extent() {
         let b = Aabb::new(Vec3::ZERO, Vec3::new(1.0, 3.0, 2.0));
-        let axes: alloc::vec::Vec<_> = LongestAxis.order(&b).iter().map(|(a, _)| a).collect();
-        assert_eq!(axes, [1]);
+        let axes: alloc::vec::Vec<_> = LongestAxis.order(&b).iter().collect();
+        assert_eq!(axes, [(1, 1.0), (2, 2.0 / 3.0), (0, 1.0 / 3.0)]);
         assert_eq!(AllAxes.order(&b).len(), 3);
     }
 

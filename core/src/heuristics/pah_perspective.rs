@@ -1,0 +1,214 @@
+//! The projected area heuristic for radial rays: perspective projection from the light, measured
+//! the way the rays are sampled.
+
+use glam::{Vec2, Vec3};
+
+use crate::geometry::{Aabb, ConvexPolygon, Frame, MAX_POLY};
+use crate::influence::PointArea;
+
+use super::CostModel;
+
+/// Which measure of a projected box is proportional to its hit probability. It must match how the
+/// rays' directions are drawn (see [`crate::influence::PointDistribution`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PerspectiveMeasure {
+    /// Solid angle: directions uniform over the sphere (or the frustum's pyramid).
+    #[default]
+    SolidAngle,
+    /// Area on the image plane `z = 1`: directions uniform on the image plane.
+    ImagePlane,
+}
+
+/// PAH for rays from a point: the box's silhouette seen from the eye, clipped to the frustum's
+/// fields of view and measured by solid angle or image-plane area. Rays start on the near plane
+/// (as the thesis cast them), so the box is first cut at the near plane: only its part beyond it can
+/// be hit. The silhouette of a convex body from a point in front of it is the convex hull of its
+/// projected vertices, so one hull of at most 14 points (8 corners, 6 near-plane cuts) and one
+/// rectangle clip give the exact measure, also for boxes that contain the eye.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PahPerspective {
+    eye: Vec3,
+    frame: Frame,
+    tan_x: f32,
+    tan_y: f32,
+    near: f32,
+    measure: PerspectiveMeasure,
+    cull: bool,
+}
+
+impl PahPerspective {
+    /// The rays of a point area, with the given measure, culled to its fields of view.
+    pub fn for_area(area: &PointArea, measure: PerspectiveMeasure) -> Self {
+        let f = area.frustum();
+        Self {
+            eye: f.eye,
+            frame: f.frame,
+            tan_x: f.tan_x,
+            tan_y: f.tan_y,
+            // A positive cut keeps every projected point finite when near is 0.
+            near: f.near.max(1e-6 * f.far),
+            measure,
+            cull: true,
+        }
+    }
+
+    /// The same model without culling to the fields of view.
+    pub fn unculled(self) -> Self {
+        Self {
+            cull: false,
+            ..self
+        }
+    }
+
+    /// The measure of the whole window: the frustum's solid angle
+    /// `4 atan(tx ty / sqrt(1 + tx^2 + ty^2))`, or its image-plane area `4 tx ty`.
+    pub fn window_measure(&self) -> f32 {
+        let (tx, ty) = (self.tan_x, self.tan_y);
+        match self.measure {
+            PerspectiveMeasure::SolidAngle => {
+                4.0 * libm::atanf(tx * ty / libm::sqrtf(1.0 + tx * tx + ty * ty))
+            }
+            PerspectiveMeasure::ImagePlane => 4.0 * tx * ty,
+        }
+    }
+
+    /// The projected silhouette of `b` beyond the near plane, on the image plane `z = 1`.
+    fn silhouette(&self, b: &Aabb) -> ConvexPolygon {
+        let local: [Vec3; 8] = core::array::from_fn(|i| {
+            let p = Vec3::new(
+                if i & 1 == 0 { b.min.x } else { b.max.x },
+                if i & 2 == 0 { b.min.y } else { b.max.y },
+                if i & 4 == 0 { b.min.z } else { b.max.z },
+            );
+            self.frame.to_local(p - self.eye)
+        });
+        let mut pts = [Vec2::ZERO; MAX_POLY];
+        let mut n = 0;
+        let project = |p: Vec3| Vec2::new(p.x / p.z, p.y / p.z);
+        for p in &local {
+            if p.z >= self.near {
+                pts[n] = project(*p);
+                n += 1;
+            }
+        }
+        if n < 8 {
+            // The 12 box edges join corners differing in one bit; those crossing the near plane
+            // contribute their crossing point.
+            for i in 0..8usize {
+                for bit in [1usize, 2, 4] {
+                    let j = i | bit;
+                    if j == i {
+                        continue;
+                    }
+                    let (a, c) = (local[i], local[j]);
+                    if (a.z < self.near) != (c.z < self.near) {
+                        let t = (self.near - a.z) / (c.z - a.z);
+                        let mut q = a + (c - a) * t;
+                        q.z = self.near;
+                        // At most 8 corners and the near-plane polygon's 6 vertices: n <= 14.
+                        if n < MAX_POLY {
+                            pts[n] = project(q);
+                            n += 1;
+                        }
+                    }
+                }
+            }
+        }
+        ConvexPolygon::hull(&pts[..n])
+    }
+}
+
+impl CostModel for PahPerspective {
+    fn measure(&self, b: &Aabb) -> f32 {
+        if b.is_empty() {
+            return 0.0;
+        }
+        let mut poly = self.silhouette(b);
+        if self.cull {
+            let t = Vec2::new(self.tan_x, self.tan_y);
+            poly = poly.clip_to_rect(-t, t);
+        }
+        match self.measure {
+            PerspectiveMeasure::SolidAngle => poly.solid_angle_on_image_plane(),
+            PerspectiveMeasure::ImagePlane => poly.area(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Ray;
+    use crate::influence::{PointDistribution, RaySampler};
+
+    #[test]
+    fn window_measures() {
+        let a = PointArea::new(Vec3::ZERO, Vec3::Z, 90.0, 90.0, 0.1, 10.0).unwrap();
+        let sa = PahPerspective::for_area(&a, PerspectiveMeasure::SolidAngle);
+        // A 90 x 90 degree pyramid is one face of a cube seen from its centre: 4 pi / 6.
+        assert!((sa.window_measure() - 4.0 * core::f32::consts::PI / 6.0).abs() < 1e-5);
+        let ip = PahPerspective::for_area(&a, PerspectiveMeasure::ImagePlane);
+        assert!((ip.window_measure() - 4.0).abs() < 1e-6);
+        // A box covering the whole window covers all of it.
+        let wall = Aabb::new(Vec3::new(-100.0, -100.0, 5.0), Vec3::new(100.0, 100.0, 6.0));
+        assert!((sa.measure(&wall) - sa.window_measure()).abs() < 1e-4);
+        assert!((ip.measure(&wall) - 4.0).abs() < 1e-4);
+        // A box around the eye covers the whole window too.
+        let around = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
+        assert!((ip.measure(&around) - 4.0).abs() < 1e-4);
+        // A box behind the eye is never hit.
+        let behind = Aabb::new(Vec3::new(-1.0, -1.0, -3.0), Vec3::new(1.0, 1.0, -2.0));
+        assert_eq!(sa.measure(&behind), 0.0);
+    }
+
+    /// The measure over the window measure is the probability that a sampled ray hits the box.
+    fn hit_fraction(area: &PointArea, dist: PointDistribution, b: &Aabb, n: u32) -> f32 {
+        let mut s = RaySampler::new((*area).into(), 1).distribution(dist);
+        let hits = (0..n)
+            .filter(|_| {
+                let r: Ray = s.sample();
+                b.intersect(&r, f32::INFINITY).is_some()
+            })
+            .count();
+        hits as f32 / n as f32
+    }
+
+    #[test]
+    fn measures_match_their_samplers_at_wide_fov() {
+        let area = PointArea::new(
+            Vec3::ZERO,
+            Vec3::new(0.2, 0.1, 1.0),
+            130.0,
+            100.0,
+            0.5,
+            50.0,
+        )
+        .unwrap();
+        let boxes = [
+            Aabb::new(Vec3::new(-1.0, -1.0, 3.0), Vec3::new(1.0, 1.0, 4.0)),
+            Aabb::new(Vec3::new(3.0, -2.0, 1.0), Vec3::new(8.0, 0.5, 2.0)),
+            Aabb::new(Vec3::new(-9.0, 1.0, 0.2), Vec3::new(-4.0, 6.0, 3.0)),
+            Aabb::new(Vec3::new(-0.3, -0.3, -0.3), Vec3::new(0.3, 0.3, 0.8)),
+        ];
+        for (dist, m) in [
+            (
+                PointDistribution::SolidAngle,
+                PerspectiveMeasure::SolidAngle,
+            ),
+            (
+                PointDistribution::ImagePlane,
+                PerspectiveMeasure::ImagePlane,
+            ),
+        ] {
+            let pah = PahPerspective::for_area(&area, m);
+            for b in &boxes {
+                let expect = pah.measure(b) / pah.window_measure();
+                let got = hit_fraction(&area, dist, b, 100_000);
+                assert!(
+                    (got - expect).abs() < 0.005,
+                    "{m:?} {b:?}: sampled {got}, measure {expect}"
+                );
+            }
+        }
+    }
+}

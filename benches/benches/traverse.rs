@@ -1,0 +1,112 @@
+//! Closest-hit and any-hit traversal of camera rays and random rays on the bunny and Crytek
+//! Sponza: rdbvh beside the peers, on the same triangles and the same rays, throughput in rays.
+//!
+//! Before anything is timed, every library's answers are compared with rdbvh's, ray by ray, and
+//! the run stops if any library agrees on fewer than [`MIN_AGREEMENT`] of the rays: a speed
+//! measured on wrong answers means nothing. The agreement rates are printed with the results.
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::measurement::WallTime;
+use criterion::{
+    criterion_group, criterion_main, BenchmarkGroup, Criterion, SamplingMode, Throughput,
+};
+use rdbvh_benches::peers::{BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Prepared, Rdbvh};
+use rdbvh_benches::{
+    agreement, bounds, load_scene, ray_set, Answers, RayKind, BENCH_SCENES, MIN_AGREEMENT,
+};
+use rdbvh_core::geometry::{Ray, Triangle};
+
+/// One library, built once, with the rays of both sets in its own format.
+struct Subject<L: Library> {
+    prepared: Prepared<L>,
+    rays: Vec<(RayKind, Vec<L::Ray>)>,
+}
+
+impl<L: Library> Subject<L> {
+    /// Builds, converts the rays and checks agreement with rdbvh's `reference` answers.
+    fn new(scene: &str, tris: &[Triangle], sets: &[(RayKind, Vec<Ray>, Answers)]) -> Self {
+        let prepared = Prepared::<L>::new(tris);
+        let mut rays = Vec::new();
+        for (kind, set, reference) in sets {
+            let native = L::rays(set);
+            let g = agreement(reference, &prepared.answers(&native));
+            println!(
+                "agreement {scene} {} {}: closest {:.4}%, any {:.4}% of {} rays",
+                kind.name(),
+                L::NAME,
+                100.0 * g.closest,
+                100.0 * g.any,
+                g.rays
+            );
+            assert!(
+                g.closest >= MIN_AGREEMENT && g.any >= MIN_AGREEMENT,
+                "{} disagrees with rdbvh on {scene} {} rays: {g:?}",
+                L::NAME,
+                kind.name()
+            );
+            rays.push((*kind, native));
+        }
+        Self { prepared, rays }
+    }
+
+    fn bench(&self, group: &mut BenchmarkGroup<'_, WallTime>, kind: RayKind, any: bool) {
+        let rays = &self.rays.iter().find(|(k, _)| *k == kind).expect("set").1;
+        group.bench_function(L::NAME, |b| {
+            if any {
+                b.iter(|| self.prepared.any_all(black_box(rays)))
+            } else {
+                b.iter(|| self.prepared.closest_all(black_box(rays)))
+            }
+        });
+    }
+}
+
+fn traversals(c: &mut Criterion) {
+    for name in BENCH_SCENES {
+        let tris = match load_scene(name) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!("traversal benchmarks skipped for {name}: {e}");
+                continue;
+            }
+        };
+        let b = bounds(&tris);
+        let reference = Prepared::<Rdbvh>::new(&tris);
+        let sets: Vec<(RayKind, Vec<Ray>, Answers)> = [RayKind::Camera, RayKind::Random]
+            .into_iter()
+            .map(|kind| {
+                let rays = ray_set(&b, kind);
+                let answers = reference.answers(&rays);
+                (kind, rays, answers)
+            })
+            .collect();
+        let rdbvh = Subject::<Rdbvh>::new(name, &tris, &sets);
+        let obvhs2 = Subject::<ObvhsBvh2>::new(name, &tris, &sets);
+        let obvhs8 = Subject::<ObvhsCwbvh>::new(name, &tris, &sets);
+        let bvh = Subject::<BvhCrate>::new(name, &tris, &sets);
+        let parry = Subject::<Parry>::new(name, &tris, &sets);
+        for (query, any) in [("closest", false), ("any", true)] {
+            for (kind, rays, _) in &sets {
+                let mut group =
+                    c.benchmark_group(format!("traverse/{name}/{query}-{}", kind.name()));
+                group
+                    .throughput(Throughput::Elements(rays.len() as u64))
+                    .sampling_mode(SamplingMode::Flat)
+                    .sample_size(10)
+                    .warm_up_time(Duration::from_millis(500))
+                    .measurement_time(Duration::from_secs(2));
+                rdbvh.bench(&mut group, *kind, any);
+                obvhs2.bench(&mut group, *kind, any);
+                obvhs8.bench(&mut group, *kind, any);
+                bvh.bench(&mut group, *kind, any);
+                parry.bench(&mut group, *kind, any);
+                group.finish();
+            }
+        }
+    }
+}
+
+criterion_group!(benches, traversals);
+criterion_main!(benches);

@@ -1,0 +1,341 @@
+//! Shared pieces of the rdbvh benchmarks: scenes, deterministic ray sets, and adapters that build and
+//! trace rdbvh and its Rust peers (`obvhs` 0.4, `bvh` 0.13, `parry3d` 0.31) on the same triangles
+//! and the same rays.
+//!
+//! Every library gets its input in its own native format, converted once outside the timed region,
+//! so a benchmark times the build or the traversal and nothing else. Every library also answers
+//! the same two questions per ray (the closest hit distance, and whether anything is hit), and
+//! [`agreement`] checks those answers against rdbvh before any timing is trusted: a fast
+//! traversal that returns the wrong triangle measures nothing.
+//!
+//! Rays have unit directions, so a hit distance means the same thing in every library (`bvh`
+//! normalises directions; rdbvh's `t` is in units of the direction).
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use rdbvh_core::build::{BuildArena, Builder};
+use rdbvh_core::bvh::Bvh;
+use rdbvh_core::geometry::{Aabb, Ray, Triangle};
+
+pub mod peers;
+
+/// Where the shared test scenes live: `../shared/scenes` beside the project's checkout.
+pub const SCENES_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/scenes");
+
+/// The scenes the benchmarks run on: the Stanford bunny (69,451 triangles, one compact closed-ish
+/// object) and Crytek Sponza (262,267 triangles, an architectural interior with large and tiny
+/// triangles mixed), the two scenes issue 2 names.
+pub const BENCH_SCENES: [&str; 2] = ["bunny", "sponza_crytek"];
+
+/// The scenes directory, or why it cannot be used. Benchmarks skip (and say why) rather than fail
+/// when `../shared` is absent: a checkout without the reference data can still build and run the
+/// rest.
+pub fn scenes_dir() -> Result<PathBuf, String> {
+    let dir = Path::new(SCENES_DIR);
+    if dir.is_dir() {
+        Ok(dir.to_path_buf())
+    } else {
+        Err(format!(
+            "{} is missing: put the shared scenes beside the checkout to run the benchmarks",
+            dir.display()
+        ))
+    }
+}
+
+/// A scene's triangles, loaded with the host crate's OBJ loader (the same path the CLI takes), so
+/// the benchmarks see exactly the triangles a user's build sees.
+pub fn load_scene(name: &str) -> Result<Vec<Triangle>, String> {
+    let path = scenes_dir()?.join(format!("{name}.obj"));
+    let scene = rdbvh::scene::Scene::load(&path)
+        .map_err(|e| format!("cannot load {}: {e}", path.display()))?;
+    if scene.triangles.is_empty() {
+        return Err(format!("{} has no triangles", path.display()));
+    }
+    Ok(scene.triangles)
+}
+
+/// The bounds of `tris`.
+pub fn bounds(tris: &[Triangle]) -> Aabb {
+    tris.iter().fold(Aabb::EMPTY, |b, t| b.union(t.bounds()))
+}
+
+/// A small, fixed-seed PRNG (SplitMix64): the ray sets must be identical on every machine and in
+/// every run, with no dependency whose stream could change between versions.
+#[derive(Clone, Debug)]
+pub struct SplitMix64(u64);
+
+impl SplitMix64 {
+    /// A generator from `seed`.
+    pub fn new(seed: u64) -> Self {
+        Self(seed)
+    }
+
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in `[0, 1)`, from the top 24 bits (every value exactly representable).
+    pub fn next_f32(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+    }
+}
+
+/// Which ray set a measurement uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayKind {
+    /// Primary rays of a pinhole camera: coherent, neighbours visit nearly the same nodes.
+    Camera,
+    /// Origins uniform in the scene's box, directions uniform on the sphere: incoherent, like
+    /// secondary rays, and they start inside the geometry.
+    Random,
+}
+
+impl RayKind {
+    /// The name used in benchmark ids and the results table.
+    pub fn name(self) -> &'static str {
+        match self {
+            RayKind::Camera => "camera",
+            RayKind::Random => "random",
+        }
+    }
+}
+
+/// Camera image side: 256 x 256 = 65,536 rays, enough that a pass takes milliseconds (well above
+/// timer resolution) and small enough that criterion's samples fit the time budget on 2 cores.
+pub const CAMERA_SIDE: u32 = 256;
+/// Random rays per set, the same count as the camera set.
+pub const RANDOM_RAYS: usize = 65_536;
+/// The seed of the random ray set.
+pub const RANDOM_SEED: u64 = 0x5EED_2026_1122;
+
+/// Primary rays of a `side` x `side` pinhole camera outside `b`, looking at its centre.
+///
+/// The eye sits on a fixed oblique direction at 1.5 times the radius of the box's bounding sphere,
+/// so it is outside the box for every scene, and the square field of view is the narrowest that
+/// holds the box's eight corners: the scene's box just fills the image whatever its units, so few
+/// rays are spent on empty background.
+pub fn camera_rays(b: &Aabb, side: u32) -> Vec<Ray> {
+    let center = b.center();
+    let radius = (0.5 * (b.max - b.min).length()).max(f32::MIN_POSITIVE);
+    let back = Vec3::new(0.35, 0.45, 1.0).normalize();
+    let eye = center + back * (1.5 * radius);
+    let forward = -back;
+    let right = forward.cross(Vec3::Y).normalize();
+    let up = right.cross(forward);
+    // Tangent of the half field of view: the largest image-plane coordinate of a corner.
+    let half = (0..8)
+        .map(|i| {
+            let corner = Vec3::select(
+                glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0),
+                b.max,
+                b.min,
+            );
+            let v = corner - eye;
+            let depth = v.dot(forward);
+            (v.dot(right) / depth).abs().max((v.dot(up) / depth).abs())
+        })
+        .fold(f32::MIN_POSITIVE, f32::max);
+    let mut rays = Vec::with_capacity((side * side) as usize);
+    for y in 0..side {
+        for x in 0..side {
+            let sx = ((x as f32 + 0.5) / side as f32 * 2.0 - 1.0) * half;
+            let sy = (1.0 - (y as f32 + 0.5) / side as f32 * 2.0) * half;
+            let dir = (forward + right * sx + up * sy).normalize();
+            rays.push(Ray::new(eye, dir).expect("finite eye and unit direction"));
+        }
+    }
+    rays
+}
+
+/// `n` rays with origins uniform in `b` and directions uniform on the unit sphere, from `seed`.
+pub fn random_rays(b: &Aabb, n: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = SplitMix64::new(seed);
+    let extent = b.max - b.min;
+    let mut rays = Vec::with_capacity(n);
+    while rays.len() < n {
+        let o = b.min + extent * Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+        // Uniform on the sphere: z uniform in [-1, 1], azimuth uniform (Archimedes).
+        let z = 2.0 * rng.next_f32() - 1.0;
+        let phi = core::f32::consts::TAU * rng.next_f32();
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        let d = Vec3::new(s * phi.cos(), s * phi.sin(), z);
+        if let Ok(ray) = Ray::new(o, d) {
+            rays.push(ray);
+        }
+    }
+    rays
+}
+
+/// The ray set of `kind` for a scene with bounds `b`.
+pub fn ray_set(b: &Aabb, kind: RayKind) -> Vec<Ray> {
+    match kind {
+        RayKind::Camera => camera_rays(b, CAMERA_SIDE),
+        RayKind::Random => random_rays(b, RANDOM_RAYS, RANDOM_SEED),
+    }
+}
+
+/// rdbvh's binned SAH build, single-threaded: allocates its arena and output per build, as the
+/// peers' builders do.
+pub fn rdbvh_build(tris: &[Triangle]) -> Bvh {
+    Builder::sah()
+        .build(tris)
+        .expect("scene triangles are finite")
+}
+
+/// rdbvh's allocation-free build path: the arena and the output are sized once and reused, which
+/// is how a renderer rebuilding every frame would call it. Reported beside [`rdbvh_build`] so the
+/// cost of the allocations is visible.
+pub struct RdbvhReuse {
+    arena: BuildArena,
+    bvh: Bvh,
+}
+
+impl RdbvhReuse {
+    /// Memory for builds over up to `n` triangles.
+    pub fn with_capacity(n: usize) -> Self {
+        Self {
+            arena: BuildArena::with_capacity(n),
+            bvh: Bvh::with_capacity(n),
+        }
+    }
+
+    /// Loads `tris` (computing their boxes, as every peer's build does) and builds into the
+    /// reused output.
+    pub fn build(&mut self, tris: &[Triangle]) -> &Bvh {
+        self.arena
+            .load_triangles(tris)
+            .expect("scene triangles are finite");
+        Builder::sah()
+            .build_into(&mut self.arena, &mut self.bvh)
+            .expect("valid default config");
+        &self.bvh
+    }
+}
+
+/// One library's answers on one ray set, for [`agreement`].
+#[derive(Clone, Debug, Default)]
+pub struct Answers {
+    /// Closest hit distance per ray, `None` on a miss.
+    pub closest: Vec<Option<f32>>,
+    /// Any-hit answer per ray.
+    pub any: Vec<bool>,
+}
+
+/// How far two closest-hit distances may differ and still agree: relative, since the scenes come
+/// in metres (bunny) and centimetres (Sponza), with an absolute floor for hits near the origin.
+/// Different but correct triangle tests differ by a few ulps on the same triangle; a distance
+/// further apart means another triangle was reported.
+pub const T_TOLERANCE: f32 = 1e-4;
+
+/// The share of rays on which two libraries agree.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Agreement {
+    /// Rays compared.
+    pub rays: usize,
+    /// Share of rays with the same closest-hit answer: both miss, or both hit at distances within
+    /// [`T_TOLERANCE`].
+    pub closest: f64,
+    /// Share of rays with the same any-hit answer.
+    pub any: f64,
+}
+
+/// The minimum agreement the benchmarks accept. Not 100%: the libraries' triangle tests differ
+/// in their edge rules (a ray through a shared edge or a vertex may hit both neighbours in one
+/// library and neither in another), and camera rays through a closed mesh's edges do occur.
+pub const MIN_AGREEMENT: f64 = 0.999;
+
+/// Compares `peer`'s answers with `reference`'s (rdbvh's), ray by ray.
+pub fn agreement(reference: &Answers, peer: &Answers) -> Agreement {
+    assert_eq!(reference.closest.len(), peer.closest.len());
+    assert_eq!(reference.any.len(), peer.any.len());
+    let rays = reference.closest.len();
+    let same_t = |a: Option<f32>, b: Option<f32>| match (a, b) {
+        (None, None) => true,
+        (Some(x), Some(y)) => (x - y).abs() <= T_TOLERANCE * x.abs().max(y.abs()).max(1e-3),
+        _ => false,
+    };
+    let closest = reference
+        .closest
+        .iter()
+        .zip(&peer.closest)
+        .filter(|(a, b)| same_t(**a, **b))
+        .count();
+    let any = reference
+        .any
+        .iter()
+        .zip(&peer.any)
+        .filter(|(a, b)| a == b)
+        .count();
+    let share = |k: usize| {
+        if rays == 0 {
+            1.0
+        } else {
+            k as f64 / rays as f64
+        }
+    };
+    Agreement {
+        rays,
+        closest: share(closest),
+        any: share(any),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube() -> Aabb {
+        Aabb::new(Vec3::splat(-1.0), Vec3::new(3.0, 1.0, 2.0))
+    }
+
+    #[test]
+    fn ray_sets_are_deterministic_and_sized() {
+        let b = cube();
+        assert_eq!(random_rays(&b, 100, 7), random_rays(&b, 100, 7));
+        assert_ne!(random_rays(&b, 100, 7), random_rays(&b, 100, 8));
+        assert_eq!(camera_rays(&b, 16).len(), 256);
+    }
+
+    #[test]
+    fn random_rays_start_inside_with_unit_directions() {
+        let b = cube();
+        for r in random_rays(&b, 1000, 1) {
+            assert!(r.origin.cmpge(b.min).all() && r.origin.cmple(b.max).all());
+            assert!((r.dir.length() - 1.0).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn camera_is_outside_and_sees_the_centre() {
+        let b = cube();
+        let rays = camera_rays(&b, 15);
+        let eye = rays[0].origin;
+        assert!(!(eye.cmpge(b.min).all() && eye.cmple(b.max).all()));
+        // The middle pixel looks straight at the centre.
+        let mid = rays[7 * 15 + 7];
+        let to_center = (b.center() - eye).normalize();
+        assert!(mid.dir.dot(to_center) > 0.9999);
+    }
+
+    #[test]
+    fn agreement_counts_tolerance_and_misses() {
+        let a = Answers {
+            closest: vec![None, Some(1.0), Some(100.0), Some(2.0)],
+            any: vec![false, true, true, true],
+        };
+        let b = Answers {
+            closest: vec![None, Some(1.00001), Some(100.5), None],
+            any: vec![false, true, true, false],
+        };
+        let g = agreement(&a, &b);
+        assert_eq!(g.rays, 4);
+        assert_eq!(g.closest, 0.5);
+        assert_eq!(g.any, 0.75);
+    }
+}

@@ -1,0 +1,393 @@
+//! One adapter per library: rdbvh and its Rust peers, behind one trait so that every benchmark and
+//! the agreement check run the same code for all of them.
+//!
+//! Choices, and why each is the fair comparison:
+//!
+//! - **rdbvh**: `Builder::sah()` (binned SAH, all three axes, 16 bins, SAH termination with leaves
+//!   up to 8), single-threaded; binary-node closest hit and any hit.
+//! - **obvhs 0.4**: `BvhBuildParams::fast_build()` as issue 2 asks, through the crate's own
+//!   helpers. obvhs does not build with binned SAH: its builder is PLOC (agglomerative clustering
+//!   over a Morton order) plus a little reinsertion, so "SAH build" here means "its fast
+//!   high-quality build". It is measured twice: `obvhs-bvh2` (`build_bvh2_from_tris`, its binary
+//!   tree, the same node kind as rdbvh) and `obvhs-cwbvh` (`build_cwbvh_from_tris`, its
+//!   8-wide compressed tree with SIMD traversal, the structure obvhs is built for and its fastest
+//!   traversal). Its `parallel` feature is off, so both builds are single-threaded. Triangle test:
+//!   obvhs's own double-sided Moller-Trumbore (`Triangle::intersect`).
+//! - **bvh 0.13**: `Bvh::build` (its binned SAH over the longest centroid axis, one shape per
+//!   leaf; the serial executor). Traversal: `bvh` has no closest-hit query of its own, only
+//!   iterators over the shapes whose boxes a ray crosses, so closest hit walks
+//!   `nearest_traverse_iterator` (near-to-far, stopping once a leaf box starts beyond the best
+//!   hit) and any hit walks `traverse_iterator` up to the first hit. Its own ray/triangle test
+//!   culls back faces, which would change the answers, so the shapes use rdbvh's
+//!   double-sided test: the comparison isolates the tree and its traversal.
+//! - **parry3d 0.31**: `Bvh::from_leaves(BvhBuildStrategy::Binned, ..)` over the triangles' boxes
+//!   (the binned SAH builder `TriMesh::new` runs; without the mesh's other bookkeeping), and
+//!   `Bvh::cast_ray` with parry's own triangle ray cast per leaf, which is exactly the path
+//!   `TriMesh::cast_local_ray` takes. Any hit uses `Bvh::traverse` with an early exit on the
+//!   first triangle hit, since parry's composite any-hit query is a full closest-hit cast.
+
+use glam::{Vec3, Vec3A};
+use rdbvh_core::build::Builder;
+use rdbvh_core::geometry::{Ray, Triangle};
+
+use crate::Answers;
+
+/// A library under test: how it takes triangles and rays, builds, and answers the two queries.
+pub trait Library {
+    /// The name in benchmark ids and the results table.
+    const NAME: &'static str;
+    /// The triangles in the library's own format.
+    type Scene;
+    /// A ray in the library's own format.
+    type Ray;
+    /// The built acceleration structure.
+    type Accel;
+
+    /// Converts triangles to the library's format (not timed).
+    fn scene(tris: &[Triangle]) -> Self::Scene;
+    /// Converts rays to the library's format (not timed).
+    fn rays(rays: &[Ray]) -> Vec<Self::Ray>;
+    /// Builds the acceleration structure, single-threaded (the timed build). Mutable because
+    /// `bvh` writes node indices into its shapes.
+    fn build(scene: &mut Self::Scene) -> Self::Accel;
+    /// The closest hit's distance along the ray, or `None`.
+    fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> Option<f32>;
+    /// Whether anything is hit along the ray.
+    fn any(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> bool;
+}
+
+/// Everything one library needs to trace: its scene, its structure and its rays.
+pub struct Prepared<L: Library> {
+    /// The library's triangles.
+    pub scene: L::Scene,
+    /// The built structure.
+    pub accel: L::Accel,
+}
+
+impl<L: Library> Prepared<L> {
+    /// Converts `tris` and builds once.
+    pub fn new(tris: &[Triangle]) -> Self {
+        let mut scene = L::scene(tris);
+        let accel = L::build(&mut scene);
+        Self { scene, accel }
+    }
+
+    /// Traces every ray with closest hit; returns the number of hits, which the benchmark loop
+    /// hands to `black_box` so no query can be optimised away.
+    #[inline]
+    pub fn closest_all(&self, rays: &[L::Ray]) -> usize {
+        rays.iter()
+            .filter(|r| L::closest(&self.accel, &self.scene, r).is_some())
+            .count()
+    }
+
+    /// Traces every ray with any hit; returns the number of hits.
+    #[inline]
+    pub fn any_all(&self, rays: &[L::Ray]) -> usize {
+        rays.iter()
+            .filter(|r| L::any(&self.accel, &self.scene, r))
+            .count()
+    }
+
+    /// Both answers for every ray, for [`crate::agreement`].
+    pub fn answers(&self, rays: &[L::Ray]) -> Answers {
+        Answers {
+            closest: rays
+                .iter()
+                .map(|r| L::closest(&self.accel, &self.scene, r))
+                .collect(),
+            any: rays
+                .iter()
+                .map(|r| L::any(&self.accel, &self.scene, r))
+                .collect(),
+        }
+    }
+}
+
+/// rdbvh: binned SAH over all axes, binary nodes.
+pub struct Rdbvh;
+
+impl Library for Rdbvh {
+    const NAME: &'static str = "rdbvh";
+    type Scene = Vec<Triangle>;
+    type Ray = Ray;
+    type Accel = rdbvh_core::bvh::Bvh;
+
+    fn scene(tris: &[Triangle]) -> Self::Scene {
+        tris.to_vec()
+    }
+    fn rays(rays: &[Ray]) -> Vec<Ray> {
+        rays.to_vec()
+    }
+    fn build(scene: &mut Self::Scene) -> Self::Accel {
+        Builder::sah()
+            .build(scene)
+            .expect("scene triangles are finite")
+    }
+    #[inline]
+    fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Ray) -> Option<f32> {
+        accel.closest_hit(ray, scene).map(|h| h.t)
+    }
+    #[inline]
+    fn any(accel: &Self::Accel, scene: &Self::Scene, ray: &Ray) -> bool {
+        accel.any_hit(ray, scene)
+    }
+}
+
+fn obvhs_scene(tris: &[Triangle]) -> Vec<obvhs::triangle::Triangle> {
+    tris.iter()
+        .map(|t| obvhs::triangle::Triangle {
+            v0: Vec3A::from(t.v0),
+            v1: Vec3A::from(t.v1),
+            v2: Vec3A::from(t.v2),
+        })
+        .collect()
+}
+
+fn obvhs_rays(rays: &[Ray]) -> Vec<obvhs::ray::Ray> {
+    rays.iter()
+        .map(|r| obvhs::ray::Ray::new(Vec3A::from(r.origin), Vec3A::from(r.dir), r.t_min, r.t_max))
+        .collect()
+}
+
+/// obvhs's binary tree from `fast_build` (PLOC + reinsertion + leaf collapse).
+pub struct ObvhsBvh2;
+
+impl Library for ObvhsBvh2 {
+    const NAME: &'static str = "obvhs-bvh2";
+    type Scene = Vec<obvhs::triangle::Triangle>;
+    type Ray = obvhs::ray::Ray;
+    type Accel = obvhs::bvh2::Bvh2;
+
+    fn scene(tris: &[Triangle]) -> Self::Scene {
+        obvhs_scene(tris)
+    }
+    fn rays(rays: &[Ray]) -> Vec<Self::Ray> {
+        obvhs_rays(rays)
+    }
+    fn build(scene: &mut Self::Scene) -> Self::Accel {
+        obvhs::bvh2::builder::build_bvh2_from_tris(
+            scene,
+            obvhs::BvhBuildParams::fast_build(),
+            &mut Default::default(),
+        )
+    }
+    #[inline]
+    fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> Option<f32> {
+        let mut hit = obvhs::ray::RayHit::none();
+        accel
+            .ray_traverse(*ray, &mut hit, |r, id| {
+                scene[accel.primitive_indices[id] as usize].intersect(r)
+            })
+            .then_some(hit.t)
+    }
+    #[inline]
+    fn any(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> bool {
+        !accel.ray_traverse_miss(*ray, |r, id| {
+            scene[accel.primitive_indices[id] as usize].intersect(r)
+        })
+    }
+}
+
+/// obvhs's 8-wide compressed tree from `fast_build`, with its SIMD traversal.
+pub struct ObvhsCwbvh;
+
+impl Library for ObvhsCwbvh {
+    const NAME: &'static str = "obvhs-cwbvh";
+    type Scene = Vec<obvhs::triangle::Triangle>;
+    type Ray = obvhs::ray::Ray;
+    type Accel = obvhs::cwbvh::CwBvh;
+
+    fn scene(tris: &[Triangle]) -> Self::Scene {
+        obvhs_scene(tris)
+    }
+    fn rays(rays: &[Ray]) -> Vec<Self::Ray> {
+        obvhs_rays(rays)
+    }
+    fn build(scene: &mut Self::Scene) -> Self::Accel {
+        obvhs::cwbvh::builder::build_cwbvh_from_tris(
+            scene,
+            obvhs::BvhBuildParams::fast_build(),
+            &mut Default::default(),
+        )
+    }
+    #[inline]
+    fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> Option<f32> {
+        let mut hit = obvhs::ray::RayHit::none();
+        accel
+            .ray_traverse(*ray, &mut hit, |r, id| {
+                scene[accel.primitive_indices[id] as usize].intersect(r)
+            })
+            .then_some(hit.t)
+    }
+    #[inline]
+    fn any(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> bool {
+        !accel.ray_traverse_miss(*ray, |r, id| {
+            scene[accel.primitive_indices[id] as usize].intersect(r)
+        })
+    }
+}
+
+/// A triangle as a `bvh` shape: its box comes from the triangle, and the crate writes the index
+/// of the leaf that holds it.
+#[derive(Clone, Copy, Debug)]
+pub struct BvhShape {
+    tri: Triangle,
+    node: usize,
+}
+
+fn point(v: Vec3) -> nalgebra::Point3<f32> {
+    nalgebra::Point3::new(v.x, v.y, v.z)
+}
+
+impl bvh::aabb::Bounded<f32, 3> for BvhShape {
+    #[inline]
+    fn aabb(&self) -> bvh::aabb::Aabb<f32, 3> {
+        let b = self.tri.bounds();
+        bvh::aabb::Aabb::with_bounds(point(b.min), point(b.max))
+    }
+}
+
+impl bvh::bounding_hierarchy::BHShape<f32, 3> for BvhShape {
+    fn set_bh_node_index(&mut self, index: usize) {
+        self.node = index;
+    }
+    fn bh_node_index(&self) -> usize {
+        self.node
+    }
+}
+
+/// A ray for the `bvh` adapter: the crate's ray for the tree, rdbvh's for the shared triangle
+/// test (same origin and unit direction, so the same distances).
+#[derive(Clone, Copy, Debug)]
+pub struct BvhRay {
+    tree: bvh::ray::Ray<f32, 3>,
+    tri: Ray,
+}
+
+/// `bvh` 0.13's binned SAH tree, one triangle per leaf.
+pub struct BvhCrate;
+
+impl Library for BvhCrate {
+    const NAME: &'static str = "bvh";
+    type Scene = Vec<BvhShape>;
+    type Ray = BvhRay;
+    type Accel = bvh::bvh::Bvh<f32, 3>;
+
+    fn scene(tris: &[Triangle]) -> Self::Scene {
+        tris.iter().map(|&tri| BvhShape { tri, node: 0 }).collect()
+    }
+    fn rays(rays: &[Ray]) -> Vec<Self::Ray> {
+        rays.iter()
+            .map(|r| BvhRay {
+                tree: bvh::ray::Ray::new(
+                    point(r.origin),
+                    nalgebra::Vector3::new(r.dir.x, r.dir.y, r.dir.z),
+                ),
+                tri: *r,
+            })
+            .collect()
+    }
+    fn build(scene: &mut Self::Scene) -> Self::Accel {
+        bvh::bvh::Bvh::build(scene)
+    }
+    #[inline]
+    fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> Option<f32> {
+        use bvh::aabb::Bounded;
+        let mut best = ray.tri.t_max;
+        let mut found = false;
+        for shape in accel.nearest_traverse_iterator(&ray.tree, scene) {
+            // Leaves come out in order of their boxes' entry distance: once one starts beyond
+            // the best hit, so do all the rest.
+            match ray.tree.intersection_slice_for_aabb(&shape.aabb()) {
+                Some((entry, _)) if entry > best => break,
+                _ => {}
+            }
+            if let Some(h) = shape.tri.intersect(&ray.tri, best) {
+                best = h.t;
+                found = true;
+            }
+        }
+        found.then_some(best)
+    }
+    #[inline]
+    fn any(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> bool {
+        accel
+            .traverse_iterator(&ray.tree, scene)
+            .any(|shape| shape.tri.intersect(&ray.tri, ray.tri.t_max).is_some())
+    }
+}
+
+/// parry3d's binned BVH over the triangles' boxes, traced with parry's triangle ray cast.
+pub struct Parry;
+
+/// parry's triangles (with its own ray cast) and the boxes its builder takes.
+pub struct ParryScene {
+    tris: Vec<parry3d::shape::Triangle>,
+    boxes: Vec<parry3d::bounding_volume::Aabb>,
+}
+
+fn pv(v: Vec3) -> parry3d::math::Vector {
+    parry3d::math::Vector::new(v.x, v.y, v.z)
+}
+
+impl Library for Parry {
+    const NAME: &'static str = "parry3d";
+    type Scene = ParryScene;
+    type Ray = parry3d::query::Ray;
+    type Accel = parry3d::partitioning::Bvh;
+
+    fn scene(tris: &[Triangle]) -> Self::Scene {
+        let tris: Vec<_> = tris
+            .iter()
+            .map(|t| parry3d::shape::Triangle::new(pv(t.v0), pv(t.v1), pv(t.v2)))
+            .collect();
+        let boxes = Vec::with_capacity(tris.len());
+        ParryScene { tris, boxes }
+    }
+    fn rays(rays: &[Ray]) -> Vec<Self::Ray> {
+        rays.iter()
+            .map(|r| parry3d::query::Ray::new(pv(r.origin), pv(r.dir)))
+            .collect()
+    }
+    fn build(scene: &mut Self::Scene) -> Self::Accel {
+        // The boxes are part of the build, as in rdbvh's (which bounds each triangle as it loads
+        // its arena) and in `TriMesh::new`.
+        scene.boxes.clear();
+        scene
+            .boxes
+            .extend(scene.tris.iter().map(|t| t.local_aabb()));
+        parry3d::partitioning::Bvh::from_leaves(
+            parry3d::partitioning::BvhBuildStrategy::Binned,
+            &scene.boxes,
+        )
+    }
+    #[inline]
+    fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> Option<f32> {
+        use parry3d::query::RayCast;
+        accel
+            .cast_ray(ray, f32::MAX, |i, best| {
+                scene.tris[i as usize].cast_local_ray(ray, best, true)
+            })
+            .map(|(_, t)| t)
+    }
+    #[inline]
+    fn any(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> bool {
+        use parry3d::partitioning::TraversalAction;
+        use parry3d::query::RayCast;
+        let mut hit = false;
+        accel.traverse(|node| {
+            if node.cast_ray(ray, f32::MAX) == f32::MAX {
+                return TraversalAction::Prune;
+            }
+            if let Some(i) = node.leaf_data() {
+                if scene.tris[i as usize].intersects_local_ray(ray, f32::MAX) {
+                    hit = true;
+                    return TraversalAction::EarlyExit;
+                }
+            }
+            TraversalAction::Continue
+        });
+        hit
+    }
+}

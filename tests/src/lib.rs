@@ -1,0 +1,292 @@
+//! Shared helpers of the integration and property tests: where the reference data lives, a
+//! deterministic random generator, ray sets, and the comparison of every BVH query against the
+//! brute-force oracle.
+//!
+//! The real scenes are read from `../shared/scenes/` beside the checkout (they must not be copied
+//! into the repository). A developer without that folder gets a printed skip; CI (`CI=true`) gets a
+//! failure, because there a missing `../shared` means the tests did not run.
+#![deny(missing_docs)]
+
+use std::path::PathBuf;
+
+use rdbvh_core::brute_force;
+use rdbvh_core::bvh::{Bvh, TraversalStats};
+use rdbvh_core::geometry::{Aabb, Ray, Triangle};
+use rdbvh_core::Vec3;
+
+/// Where `../shared` is expected: beside the checkout, two levels above this crate.
+pub const SHARED_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared");
+
+/// True when the environment says this is a CI run (`CI=true`, as CI sets it).
+pub fn in_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| v.eq_ignore_ascii_case("true") || v == "1")
+}
+
+/// The `../shared` folder, or `None` after printing `skipped: ../shared not found (<reason>)`.
+///
+/// # Panics
+/// When `CI=true` and the folder is missing: in CI a missing `../shared` is a failure, not a skip.
+pub fn require_shared() -> Option<PathBuf> {
+    let path = PathBuf::from(SHARED_DIR);
+    let reason = match std::fs::metadata(&path) {
+        Ok(m) if m.is_dir() => return Some(path.canonicalize().unwrap_or(path)),
+        Ok(_) => format!("{} is not a directory", path.display()),
+        Err(e) => format!("{}: {e}", path.display()),
+    };
+    if in_ci() {
+        panic!("../shared not found ({reason}): with CI=true the real-scene tests must run, so a missing ../shared is a failure");
+    }
+    println!("skipped: ../shared not found ({reason})");
+    None
+}
+
+/// A scene file under `../shared/scenes/`, or `None` (with the same skip or CI failure as
+/// [`require_shared`]). A missing file inside an existing `../shared` is always a failure.
+pub fn require_scene(relative: &str) -> Option<PathBuf> {
+    let path = require_shared()?.join("scenes").join(relative);
+    assert!(
+        path.is_file(),
+        "scene {} is missing from ../shared/scenes",
+        path.display()
+    );
+    Some(path)
+}
+
+/// SplitMix64: a tiny deterministic generator, so real-scene tests trace the same rays every run.
+#[derive(Clone, Debug)]
+pub struct Rng(u64);
+
+impl Rng {
+    /// A generator from a seed.
+    pub fn new(seed: u64) -> Self {
+        Self(seed)
+    }
+
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in `[0, 1)`.
+    pub fn f32(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    /// Uniform in `[lo, hi)`.
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.f32()
+    }
+
+    /// Uniform in `0..n` (`n > 0`).
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next_u64() % n as u64) as usize
+    }
+
+    /// A point uniform in the box.
+    pub fn in_box(&mut self, b: &Aabb) -> Vec3 {
+        Vec3::new(
+            self.range(b.min.x, b.max.x),
+            self.range(b.min.y, b.max.y),
+            self.range(b.min.z, b.max.z),
+        )
+    }
+
+    /// A direction uniform on the unit sphere.
+    pub fn unit_vector(&mut self) -> Vec3 {
+        let z = self.range(-1.0, 1.0);
+        let phi = self.range(0.0, std::f32::consts::TAU);
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    }
+}
+
+/// The bounds of all triangles.
+pub fn scene_bounds(tris: &[Triangle]) -> Aabb {
+    tris.iter().fold(Aabb::EMPTY, |b, t| b.union(t.bounds()))
+}
+
+/// Camera-like rays: origins on a sphere around the scene (outside its bounds), each aimed at a
+/// random point inside the bounds, so most of them hit something.
+pub fn camera_rays(bounds: &Aabb, count: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng::new(seed);
+    let centre = bounds.center();
+    let radius = bounds.extent().length().max(1e-3);
+    (0..count)
+        .filter_map(|_| {
+            let eye = centre + rng.unit_vector() * (1.5 * radius);
+            let target = rng.in_box(bounds);
+            Ray::new(eye, target - eye).ok()
+        })
+        .collect()
+}
+
+/// Rays from random points inside the bounds in random directions; every fourth one is a finite
+/// segment (a shadow ray towards another point inside the bounds, `t` in `[0, 1]`).
+pub fn interior_rays(bounds: &Aabb, count: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng::new(seed);
+    (0..count)
+        .filter_map(|i| {
+            let o = rng.in_box(bounds);
+            if i % 4 == 3 {
+                let p = rng.in_box(bounds);
+                Ray::segment(o, p - o, 0.0, 1.0).ok()
+            } else {
+                Ray::new(o, rng.unit_vector()).ok()
+            }
+        })
+        .collect()
+}
+
+/// Which open core bug (each reproduced by an ignored test in `tests/core_bugs.rs`) a ray runs
+/// into, if any, so that property tests can set those rays aside by name instead of loosening their
+/// assertions. Remove a case here when the core fixes it.
+pub fn known_core_bug(ray: &Ray, tris: &[Triangle]) -> Option<&'static str> {
+    for tri in tris {
+        let Some(h) = tri.intersect(ray, ray.t_max) else {
+            continue;
+        };
+        if !h.t.is_finite() {
+            // Moller-Trumbore's `t` overflowed to an infinity and was accepted as a hit.
+            return Some("core_bug_infinite_t_hit");
+        }
+        // The triangle test's hit must pass the box test of the triangle's own box at that `t`
+        // (then it passes every enclosing node's too, the slab test being monotonic in the box).
+        // When it does not, the two core tests disagree through rounding and the BVH cannot find
+        // the hit, whatever its structure.
+        let at_hit = Ray::segment(ray.origin, ray.dir, h.t, h.t).ok()?;
+        if tri.bounds().intersect(&at_hit, h.t).is_none() {
+            return Some("core_bug_rounding_hit_outside_triangle_box");
+        }
+        // A hit before the (padded) entry of its triangle's own box: the ordered closest-hit walk
+        // may prune the subtree holding it after an equally close (or farther by rounding) hit.
+        if h.t < tri.bounds().slab_interval(ray, ray.t_max).0 {
+            return Some("core_bug_ordered_prune_breaks_tie_rule");
+        }
+    }
+    None
+}
+
+/// Counters of a comparison run, for a test's report and its sanity checks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Agreement {
+    /// Rays compared.
+    pub rays: usize,
+    /// Rays with a closest hit.
+    pub hits: usize,
+}
+
+/// Checks one ray against the oracle: the closest hit is exactly the oracle's, any-hit agrees with
+/// it, the all-hit walk counts exactly the oracle's hits and tests at least that many triangles,
+/// and the traversal counters are consistent with the tree. Returns the closest hit.
+///
+/// # Panics
+/// On the first disagreement, naming the ray.
+pub fn check_ray(bvh: &Bvh, tris: &[Triangle], ray: &Ray) -> Option<rdbvh_core::bvh::Hit> {
+    let expect = brute_force::closest_hit(ray, tris);
+    let mut cs = TraversalStats::default();
+    let got = bvh.closest_hit_with_stats(ray, tris, &mut cs);
+    assert_eq!(
+        got, expect,
+        "closest hit differs from brute force for {ray:?}"
+    );
+    assert_eq!(
+        bvh.closest_hit(ray, tris),
+        got,
+        "closest_hit and closest_hit_with_stats differ for {ray:?}"
+    );
+    let mut anys = TraversalStats::default();
+    let any = bvh.any_hit_with_stats(ray, tris, &mut anys);
+    assert_eq!(
+        any,
+        brute_force::any_hit(ray, tris),
+        "any hit differs from brute force for {ray:?}"
+    );
+    assert_eq!(
+        any,
+        expect.is_some(),
+        "any hit and closest hit disagree for {ray:?}"
+    );
+    assert_eq!(bvh.any_hit(ray, tris), any);
+    let all = bvh.all_hit(ray, tris);
+    assert_eq!(
+        all.hits,
+        brute_force::hit_count(ray, tris),
+        "all-hit count differs from brute force for {ray:?}"
+    );
+    assert!(all.triangles >= all.hits, "{all:?} for {ray:?}");
+    check_stats_sane(bvh, &cs, expect.is_some(), ray);
+    check_stats_sane(bvh, &anys, any, ray);
+    // The ordered and the early-exit walks never do more than the exhaustive one.
+    for s in [&cs, &anys] {
+        assert!(
+            s.inner_nodes <= all.inner_nodes
+                && s.leaves <= all.leaves
+                && s.triangles <= all.triangles,
+            "traversal {s:?} did more than the all-hit walk {all:?} for {ray:?}"
+        );
+    }
+    expect
+}
+
+/// Counters of one closest-hit or any-hit query: within the tree's size, leaves visited only if
+/// the walk reached them, and at least one triangle tested when something was hit.
+pub fn check_stats_sane(bvh: &Bvh, s: &TraversalStats, hit: bool, ray: &Ray) {
+    let leaves = bvh.leaf_count() as u32;
+    let inner = bvh.nodes().len() as u32 - leaves.min(bvh.nodes().len() as u32);
+    let prims = bvh.prim_indices().len() as u32;
+    assert!(
+        s.inner_nodes <= inner,
+        "{s:?} > {inner} inner nodes for {ray:?}"
+    );
+    assert!(s.leaves <= leaves, "{s:?} > {leaves} leaves for {ray:?}");
+    assert!(
+        s.triangles <= prims,
+        "{s:?} > {prims} triangles for {ray:?}"
+    );
+    if hit {
+        assert!(
+            s.leaves >= 1 && s.triangles >= 1,
+            "a hit with {s:?} for {ray:?}"
+        );
+    }
+    if s.leaves > 0 && inner > 0 {
+        assert!(
+            s.inner_nodes >= 1,
+            "a leaf below the root reached without the root: {s:?}"
+        );
+    }
+}
+
+/// Checks every ray of `rays` with [`check_ray`].
+pub fn check_rays(bvh: &Bvh, tris: &[Triangle], rays: &[Ray]) -> Agreement {
+    let mut a = Agreement::default();
+    for ray in rays {
+        a.rays += 1;
+        if check_ray(bvh, tris, ray).is_some() {
+            a.hits += 1;
+        }
+    }
+    a
+}
+
+/// Validates a BVH built over `tris` (every invariant of [`Bvh::validate`]) and checks its shape:
+/// at most `2n - 1` nodes, all triangles referenced.
+///
+/// # Panics
+/// When an invariant is broken.
+pub fn check_structure(bvh: &Bvh, tris: &[Triangle]) {
+    if let Err(e) = bvh.validate(tris.len(), |i| tris[i as usize].bounds()) {
+        panic!("BVH over {} triangles is invalid: {e} ({e:?})", tris.len());
+    }
+    assert!(bvh.nodes().len() <= (2 * tris.len()).saturating_sub(1));
+    assert_eq!(bvh.prim_indices().len(), tris.len());
+    assert!(bvh.max_depth() <= rdbvh_core::bvh::MAX_DEPTH);
+    if !tris.is_empty() {
+        let root = bvh.bounds();
+        assert!(root.contains_box(&scene_bounds(tris)) && scene_bounds(tris).contains_box(&root));
+    }
+}

@@ -8,7 +8,9 @@
 mod arena;
 mod builder;
 mod config;
+mod preset;
 
 pub use arena::BuildArena;
 pub use builder::{BuildStats, Builder};
 pub use config::{BinSpace, BuildConfig, CutEvaluation, ThesisCut, MAX_BINS};
+pub use preset::{AreaPah, Preset, PresetError, PresetOptions};

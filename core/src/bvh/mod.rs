@@ -96,11 +96,18 @@ impl Bvh {
     /// m(leaf) / m(root)`. With [`crate::heuristics::Sah`] this is the SAH cost. Zero for an empty
     /// BVH or a root of zero measure.
     pub fn estimated_cost(&self, model: &impl CostModel, k: CostConstants) -> f32 {
-        let root = model.measure(&self.bounds());
-        if self.nodes.is_empty() || root <= 0.0 {
+        self.estimated_cost_over(model, k, model.measure(&self.bounds()))
+    }
+
+    /// The expected cost of a ray drawn from a distribution of total measure `total` (for an
+    /// influence area, its window's measure): the same sum as [`Bvh::estimated_cost`] over `total`
+    /// instead of the root's measure, so rays that miss the root count as costing nothing, as they
+    /// do when rays are traced. Zero for an empty BVH or a non-positive `total`.
+    pub fn estimated_cost_over(&self, model: &impl CostModel, k: CostConstants, total: f32) -> f32 {
+        if self.nodes.is_empty() || !(total > 0.0) {
             return 0.0;
         }
-        let total: f64 = self
+        let sum: f64 = self
             .nodes
             .iter()
             .map(|n| {
@@ -112,6 +119,6 @@ impl Bvh {
                 }
             })
             .sum();
-        (total / f64::from(root)) as f32
+        (sum / f64::from(total)) as f32
     }
 }

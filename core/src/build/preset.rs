@@ -1,0 +1,482 @@
+//! Presets: the thesis's named heuristic pairs, and the state of the art, as ready builders.
+
+use core::fmt;
+
+use super::{BinSpace, BuildArena, BuildConfig, BuildStats, Builder, CutEvaluation, ThesisCut};
+use crate::bvh::Bvh;
+use crate::geometry::Aabb;
+use crate::heuristics::{
+    AllAxes, AxisChooser, CostConstants, CostModel, LeafSize, LongestAxis, PahOrtho,
+    PahPerspective, PerspectiveMeasure, Sah, SahTermination, Spfh, Termination,
+};
+use crate::influence::InfluenceArea;
+use crate::BuildError;
+
+/// A named builder. The thesis's four pairs plus binned SAH over all axes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Preset {
+    /// Binned SAH over all three axes: the real state of the art, and the fallback BVH.
+    Sah,
+    /// SAH + LSPH: the thesis's "standard".
+    Standard,
+    /// SAH + SPFH: the thesis's "facing".
+    Facing,
+    /// PAH + LSPH: the thesis's "longest".
+    Longest,
+    /// PAH + SPFH: the thesis's "full".
+    Full,
+}
+
+impl Preset {
+    /// Every preset, in a fixed order.
+    pub const ALL: [Preset; 5] = [
+        Preset::Sah,
+        Preset::Standard,
+        Preset::Facing,
+        Preset::Longest,
+        Preset::Full,
+    ];
+
+    /// The preset's name: `sah`, `standard`, `facing`, `longest` or `full`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Sah => "sah",
+            Preset::Standard => "standard",
+            Preset::Facing => "facing",
+            Preset::Longest => "longest",
+            Preset::Full => "full",
+        }
+    }
+
+    /// The preset of a name (as [`Preset::name`] spells it, case-insensitive).
+    pub fn from_name(name: &str) -> Option<Preset> {
+        Preset::ALL
+            .into_iter()
+            .find(|p| p.name().eq_ignore_ascii_case(name))
+    }
+
+    /// The thesis's capitalised name for result rows (`Full`, `Longest`, `Facing`, `Standard`,
+    /// and `Sah`).
+    pub fn thesis_name(self) -> &'static str {
+        match self {
+            Preset::Sah => "Sah",
+            Preset::Standard => "Standard",
+            Preset::Facing => "Facing",
+            Preset::Longest => "Longest",
+            Preset::Full => "Full",
+        }
+    }
+
+    /// True when the preset needs an influence area (it uses PAH or SPFH).
+    pub fn needs_area(self) -> bool {
+        matches!(self, Preset::Facing | Preset::Longest | Preset::Full)
+    }
+
+    /// True when the preset prices splits with PAH.
+    pub fn uses_pah(self) -> bool {
+        matches!(self, Preset::Longest | Preset::Full)
+    }
+}
+
+impl fmt::Display for Preset {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Settings shared by every preset.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PresetOptions {
+    /// Bins (candidate planes + 1) per axis.
+    pub bins: u32,
+    /// Largest leaf the termination rule may keep.
+    pub max_leaf: u32,
+    /// Cost constants.
+    pub constants: CostConstants,
+    /// How perspective PAH measures a projection (point areas).
+    pub perspective: PerspectiveMeasure,
+    /// Reproduce the thesis's builder: candidate planes uniformly over the node box, leaves split
+    /// down to `max_leaf` by size alone (no cost-based termination).
+    pub thesis_mode: bool,
+    /// The cut evaluation's thresholds; its quality threshold applies to SPFH presets, and
+    /// [`ThesisCut::LSPH`]'s to LSPH ones unless changed in `lsph_quality_threshold`.
+    pub cut: ThesisCut,
+    /// The quality threshold for LSPH presets.
+    pub lsph_quality_threshold: f32,
+}
+
+impl Default for PresetOptions {
+    /// This project's defaults: 16 centroid bins, SAH termination up to 8 triangles per leaf,
+    /// `C_trav = C_isect = 1`, solid-angle perspective PAH, the thesis's cut thresholds.
+    fn default() -> Self {
+        Self {
+            bins: 16,
+            max_leaf: 8,
+            constants: CostConstants::default(),
+            perspective: PerspectiveMeasure::SolidAngle,
+            thesis_mode: false,
+            cut: ThesisCut::SPFH,
+            lsph_quality_threshold: ThesisCut::LSPH.quality_threshold,
+        }
+    }
+}
+
+impl PresetOptions {
+    /// The thesis's settings (`experiments.toml`): 40 candidate planes over the node box, at most 2
+    /// triangles per leaf with no cost-based termination, 1.0 per inner node counted twice and 1.2
+    /// per triangle.
+    pub fn thesis() -> Self {
+        Self {
+            bins: 41,
+            max_leaf: 2,
+            constants: CostConstants::THESIS,
+            perspective: PerspectiveMeasure::SolidAngle,
+            thesis_mode: true,
+            cut: ThesisCut::SPFH,
+            lsph_quality_threshold: ThesisCut::LSPH.quality_threshold,
+        }
+    }
+
+    fn config(&self, cut: CutEvaluation) -> BuildConfig {
+        BuildConfig {
+            bins: self.bins,
+            constants: self.constants,
+            cut,
+            bin_space: if self.thesis_mode {
+                BinSpace::NodeBox
+            } else {
+                BinSpace::Centroids
+            },
+            ..BuildConfig::default()
+        }
+    }
+}
+
+/// Why a preset could not build.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PresetError {
+    /// The preset uses PAH or SPFH and no influence area was given.
+    NeedsArea(Preset),
+    /// The build itself failed.
+    Build(BuildError),
+}
+
+impl fmt::Display for PresetError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PresetError::NeedsArea(p) => write!(
+                f,
+                "preset `{p}` uses PAH or SPFH and needs an influence area (give --areas)"
+            ),
+            PresetError::Build(e) => e.fmt(f),
+        }
+    }
+}
+
+impl From<BuildError> for PresetError {
+    fn from(e: BuildError) -> Self {
+        PresetError::Build(e)
+    }
+}
+
+/// PAH for an influence area: orthographic for a plane area, perspective for a point area. For
+/// estimating a built tree's cost (the builders themselves are monomorphised per kind).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AreaPah {
+    /// Parallel rays.
+    Ortho(PahOrtho),
+    /// Radial rays.
+    Perspective(PahPerspective),
+}
+
+impl AreaPah {
+    /// The PAH of `area`, culled to its window.
+    pub fn new(area: &InfluenceArea, perspective: PerspectiveMeasure) -> Self {
+        match area {
+            InfluenceArea::Plane(a) => AreaPah::Ortho(PahOrtho::for_area(a)),
+            InfluenceArea::Point(a) => {
+                AreaPah::Perspective(PahPerspective::for_area(a, perspective))
+            }
+        }
+    }
+
+    /// The measure of the whole window: every sampled ray starts in it, so a box's measure over
+    /// this is its hit probability.
+    pub fn window_measure(&self) -> f32 {
+        match self {
+            AreaPah::Ortho(p) => p.window_measure().unwrap_or(0.0),
+            AreaPah::Perspective(p) => p.window_measure(),
+        }
+    }
+}
+
+impl CostModel for AreaPah {
+    fn measure(&self, b: &Aabb) -> f32 {
+        match self {
+            AreaPah::Ortho(p) => p.measure(b),
+            AreaPah::Perspective(p) => p.measure(b),
+        }
+    }
+}
+
+impl Preset {
+    /// Builds the arena's primitives with this preset into `out`. `area` is required for
+    /// `facing`, `longest` and `full`, ignored by `sah` and `standard`.
+    pub fn build_into(
+        self,
+        area: Option<&InfluenceArea>,
+        options: &PresetOptions,
+        arena: &mut BuildArena,
+        out: &mut Bvh,
+    ) -> Result<BuildStats, PresetError> {
+        let lsph = CutEvaluation::Thesis(ThesisCut {
+            quality_threshold: options.lsph_quality_threshold,
+            ..options.cut
+        });
+        let spfh = CutEvaluation::Thesis(options.cut);
+        let area = match (self.needs_area(), area) {
+            (true, None) => return Err(PresetError::NeedsArea(self)),
+            (_, a) => a,
+        };
+        match (self, area) {
+            (Preset::Sah, _) => run(
+                AllAxes,
+                Sah,
+                options,
+                options.config(CutEvaluation::BestOfAxes),
+                arena,
+                out,
+            ),
+            (Preset::Standard, _) => {
+                run(LongestAxis, Sah, options, options.config(lsph), arena, out)
+            }
+            (Preset::Facing, Some(a)) => run(
+                Spfh::for_area(a),
+                Sah,
+                options,
+                options.config(spfh),
+                arena,
+                out,
+            ),
+            (Preset::Longest, Some(InfluenceArea::Plane(a))) => run(
+                LongestAxis,
+                PahOrtho::for_area(a),
+                options,
+                options.config(lsph),
+                arena,
+                out,
+            ),
+            (Preset::Longest, Some(InfluenceArea::Point(a))) => run(
+                LongestAxis,
+                PahPerspective::for_area(a, options.perspective),
+                options,
+                options.config(lsph),
+                arena,
+                out,
+            ),
+            (Preset::Full, Some(area @ InfluenceArea::Plane(a))) => run(
+                Spfh::for_area(area),
+                PahOrtho::for_area(a),
+                options,
+                options.config(spfh),
+                arena,
+                out,
+            ),
+            (Preset::Full, Some(area @ InfluenceArea::Point(a))) => run(
+                Spfh::for_area(area),
+                PahPerspective::for_area(a, options.perspective),
+                options,
+                options.config(spfh),
+                arena,
+                out,
+            ),
+            (_, None) => Err(PresetError::NeedsArea(self)),
+        }
+    }
+}
+
+/// One monomorphised build per (chooser, cost model), with the options' termination rule.
+fn run<A: AxisChooser, C: CostModel>(
+    axes: A,
+    cost: C,
+    options: &PresetOptions,
+    config: BuildConfig,
+    arena: &mut BuildArena,
+    out: &mut Bvh,
+) -> Result<BuildStats, PresetError> {
+    fn go<A: AxisChooser, C: CostModel, T: Termination>(
+        b: Builder<A, C, T>,
+        arena: &mut BuildArena,
+        out: &mut Bvh,
+    ) -> Result<BuildStats, PresetError> {
+        Ok(b.build_into(arena, out)?)
+    }
+    if options.thesis_mode {
+        let stop = LeafSize {
+            max_leaf: options.max_leaf,
+        };
+        go(Builder::new(axes, cost, stop, config), arena, out)
+    } else {
+        let stop = SahTermination {
+            max_leaf: options.max_leaf,
+        };
+        go(Builder::new(axes, cost, stop, config), arena, out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use alloc::vec::Vec;
+
+    use glam::Vec3;
+
+    use super::*;
+    use crate::brute_force;
+    use crate::geometry::Triangle;
+    use crate::influence::{PlaneArea, PointArea, RaySampler};
+    use crate::random::Pcg32;
+
+    fn soup(n: usize) -> Vec<Triangle> {
+        let mut rng = Pcg32::new(1);
+        let mut v = || {
+            Vec3::new(
+                rng.range(0.0, 10.0),
+                rng.range(0.0, 10.0),
+                rng.range(0.0, 10.0),
+            )
+        };
+        (0..n)
+            .map(|_| {
+                let a = v();
+                Triangle::new(
+                    a,
+                    a + (v() - Vec3::splat(5.0)) * 0.2,
+                    a + (v() - Vec3::splat(5.0)) * 0.2,
+                )
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_preset_on_both_area_kinds_agrees_with_brute_force() {
+        let tris = soup(400);
+        let areas: [InfluenceArea; 2] = [
+            PlaneArea::new(
+                Vec3::new(3.5, 5.0, -4.0),
+                Vec3::new(0.259, 0.0, 0.966),
+                6.5,
+                5.0,
+                20.0,
+            )
+            .unwrap()
+            .into(),
+            PointArea::new(
+                Vec3::new(10.0, 12.0, -3.0),
+                Vec3::new(-0.55, -0.9, 1.0),
+                60.0,
+                60.0,
+                1.0,
+                20.0,
+            )
+            .unwrap()
+            .into(),
+        ];
+        for options in [PresetOptions::default(), PresetOptions::thesis()] {
+            for area in &areas {
+                for preset in Preset::ALL {
+                    let mut arena = BuildArena::with_capacity(tris.len());
+                    arena.load_triangles(&tris).unwrap();
+                    let mut bvh = Bvh::with_capacity(tris.len());
+                    preset
+                        .build_into(Some(area), &options, &mut arena, &mut bvh)
+                        .unwrap();
+                    bvh.validate(tris.len(), |i| tris[i as usize].bounds())
+                        .unwrap();
+                    if options.thesis_mode {
+                        assert!(bvh.nodes().iter().all(|n| n.count <= 2), "{preset}");
+                    }
+                    let mut rays = RaySampler::new(*area, 3);
+                    for _ in 0..200 {
+                        let r = rays.sample();
+                        assert_eq!(
+                            bvh.closest_hit(&r, &tris),
+                            brute_force::closest_hit(&r, &tris)
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// PAH's estimate of a built tree equals the all-hit cost of the rays it models.
+    #[test]
+    fn pah_estimate_matches_measured_all_hit_cost() {
+        let tris = soup(2000);
+        let areas: [InfluenceArea; 2] = [
+            PlaneArea::new(
+                Vec3::new(3.5, 5.0, -4.0),
+                Vec3::new(0.259, 0.0, 0.966),
+                6.5,
+                5.0,
+                20.0,
+            )
+            .unwrap()
+            .into(),
+            PointArea::new(
+                Vec3::new(5.0, 5.0, -4.0),
+                Vec3::new(0.1, 0.05, 1.0),
+                130.0,
+                100.0,
+                1.0,
+                40.0,
+            )
+            .unwrap()
+            .into(),
+        ];
+        for area in &areas {
+            let inside: Vec<u32> = (0..tris.len() as u32)
+                .filter(|&i| area.overlaps_triangle(&tris[i as usize]))
+                .collect();
+            let mut arena = BuildArena::with_capacity(tris.len());
+            arena
+                .load_triangle_subset(&tris, inside.iter().copied())
+                .unwrap();
+            let mut bvh = Bvh::with_capacity(tris.len());
+            let o = PresetOptions::thesis();
+            Preset::Full
+                .build_into(Some(area), &o, &mut arena, &mut bvh)
+                .unwrap();
+            let pah = AreaPah::new(area, o.perspective);
+            let estimate = bvh.estimated_cost_over(&pah, o.constants, pah.window_measure());
+            let mut rays = RaySampler::new(*area, 17)
+                .distribution(crate::influence::PointDistribution::SolidAngle);
+            let n = 100_000;
+            let measured: f64 = (0..n)
+                .map(|_| f64::from(bvh.all_hit(&rays.sample(), &tris).cost(o.constants)))
+                .sum::<f64>()
+                / f64::from(n);
+            let err = (f64::from(estimate) - measured).abs() / measured;
+            assert!(
+                err < 0.02,
+                "{area:?}: estimate {estimate}, measured {measured}, error {err}"
+            );
+        }
+    }
+
+    #[test]
+    fn presets_needing_an_area_say_so() {
+        let mut arena = BuildArena::with_capacity(4);
+        arena.load_triangles(&soup(4)).unwrap();
+        let mut bvh = Bvh::default();
+        let o = PresetOptions::default();
+        assert_eq!(
+            Preset::Full.build_into(None, &o, &mut arena, &mut bvh),
+            Err(PresetError::NeedsArea(Preset::Full))
+        );
+        assert!(Preset::Standard
+            .build_into(None, &o, &mut arena, &mut bvh)
+            .is_ok());
+        assert_eq!(Preset::from_name("FULL"), Some(Preset::Full));
+        assert_eq!(Preset::from_name("nope"), None);
+    }
+}

@@ -88,11 +88,13 @@ impl Bin {
     };
 }
 
-/// A node waiting to be processed: its slot range, depth and centroid bounds (doubled, like
-/// [`PrimRefs::centroid2`]).
+/// A node waiting to be processed: its exact bounds, slot range, depth and centroid bounds
+/// (doubled, like [`PrimRefs::centroid2`]).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Task {
     pub node: u32,
+    /// The node's exact bounds (nodes store them padded).
+    pub bounds: Aabb,
     pub start: u32,
     pub count: u32,
     pub depth: u32,
@@ -191,6 +193,10 @@ impl BuildArena {
             let tri = tris
                 .get(id as usize)
                 .ok_or(BuildError::InvalidPrimitive { index: id })?;
+            // `Vec3::min`/`max` drop a NaN operand, so the bounds alone could hide one.
+            if !tri.is_finite() {
+                return Err(BuildError::InvalidPrimitive { index: id });
+            }
             self.push(id, tri.bounds())?;
         }
         Ok(())

@@ -188,6 +188,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         arena.tasks.clear();
         let mut task = Task {
             node: 0,
+            bounds: arena.bounds,
             start: 0,
             count: n as u32,
             depth: 0,
@@ -195,12 +196,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         };
         loop {
             stats.max_depth = stats.max_depth.max(task.depth);
-            match self.split(
-                arena,
-                &task,
-                &out.nodes[task.node as usize].bounds(),
-                &mut stats,
-            ) {
+            match self.split(arena, &task, &task.bounds, &mut stats) {
                 None => stats.leaves += 1,
                 Some((left, right)) => {
                     let l = out.nodes.len() as u32;
@@ -212,6 +208,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                     let depth = task.depth + 1;
                     arena.tasks.push(Task {
                         node: l + 1,
+                        bounds: right.0,
                         start: task.start + left.1,
                         count: right.1,
                         depth,
@@ -219,6 +216,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                     });
                     task = Task {
                         node: l,
+                        bounds: left.0,
                         start: task.start,
                         count: left.1,
                         depth,

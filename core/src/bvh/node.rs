@@ -28,9 +28,11 @@ static_assertions::assert_eq_size!(BvhNode, [u8; 32]);
 static_assertions::const_assert_eq!(core::mem::align_of::<BvhNode>(), 32);
 
 impl BvhNode {
-    /// A leaf over `count` primitive slots starting at `first`.
+    /// A leaf over `count` primitive slots starting at `first`. The box is stored
+    /// [`Aabb::padded`], so box tests stay conservative under the triangle test's rounding.
     #[inline]
     pub fn leaf(bounds: Aabb, first: u32, count: u32) -> Self {
+        let bounds = bounds.padded();
         Self {
             min: bounds.min.to_array(),
             left_first: first,
@@ -39,9 +41,10 @@ impl BvhNode {
         }
     }
 
-    /// An inner node whose children sit at `left` and `left + 1`.
+    /// An inner node whose children sit at `left` and `left + 1`; its box is stored padded.
     #[inline]
     pub fn inner(bounds: Aabb, left: u32) -> Self {
+        let bounds = bounds.padded();
         Self {
             min: bounds.min.to_array(),
             left_first: left,

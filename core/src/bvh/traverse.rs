@@ -1,7 +1,7 @@
 //! Traversal of a binary BVH: closest hit, any hit and the all-hit cost, each over a fixed stack.
 
 use super::{Bvh, BvhNode, MAX_DEPTH};
-use crate::geometry::{Ray, Triangle};
+use crate::geometry::{pad_far, Ray, Triangle};
 use crate::heuristics::CostConstants;
 
 /// The closest intersection along a ray.
@@ -183,7 +183,8 @@ impl Bvh {
                 let Some((next, t_entry)) = stack.pop() else {
                     return best;
                 };
-                if best.is_none_or(|b| t_entry <= b.t) {
+                // The same padded bound the box test used when it admitted the subtree.
+                if best.is_none_or(|b| t_entry <= pad_far(b.t)) {
                     index = next;
                     break;
                 }

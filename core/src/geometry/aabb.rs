@@ -4,6 +4,12 @@ use glam::Vec3;
 
 use super::Ray;
 
+/// `t_far` widened by the slab padding: the bound a traversal compares entry distances against.
+#[inline]
+pub(crate) fn pad_far(t_far: f32) -> f32 {
+    t_far + t_far.abs() * SLAB_PAD
+}
+
 /// Relative padding of the slab test's interval: `2 * gamma(3)` in the notation of Ize, "Robust BVH
 /// Ray Traversal" (JCGT 2013). It keeps a box test conservative under the rounding of the slab
 /// products, so a triangle lying exactly on a box face (an axis-aligned wall) is never culled.
@@ -121,6 +127,27 @@ impl Aabb {
         }
     }
 
+    /// This box grown by a relative `2^-19` of its largest coordinate magnitude on every side.
+    ///
+    /// BVH nodes store these: a ray/triangle test rounds its hit point by a few ulps of the
+    /// coordinates involved, which can put a hit a hair outside the triangle's exact box (a ray
+    /// starting on a vertex, or grazing a face). The padding, far above those ulps and far below
+    /// any geometric feature, makes every box test admit every hit the triangle test reports, so
+    /// traversals agree with the brute-force oracle. A parent's padding is never smaller than its
+    /// children's, so nesting is kept.
+    #[inline]
+    pub fn padded(self) -> Self {
+        if self.is_empty() {
+            return self;
+        }
+        let m = self.min.abs().max(self.max.abs()).max_element();
+        let pad = Vec3::splat(m * (1.0 / 524_288.0) + f32::MIN_POSITIVE);
+        Self {
+            min: self.min - pad,
+            max: self.max + pad,
+        }
+    }
+
     /// True when `other` lies inside this box (boundaries included).
     #[inline]
     pub fn contains_box(&self, other: &Aabb) -> bool {
@@ -156,10 +183,7 @@ impl Aabb {
         let tf = (far - ray.origin) * ray.inv_dir;
         let t_near = ray.t_min.max(tn.x).max(tn.y).max(tn.z);
         let t_far = t_max.min(tf.x).min(tf.y).min(tf.z);
-        (
-            t_near - t_near.abs() * SLAB_PAD,
-            t_far + t_far.abs() * SLAB_PAD,
-        )
+        (t_near - t_near.abs() * SLAB_PAD, pad_far(t_far))
     }
 }
 

@@ -10,6 +10,7 @@ mod polygon;
 mod ray;
 mod triangle;
 
+pub(crate) use aabb::pad_far;
 pub use aabb::Aabb;
 pub use convex::{Plane, Polytope};
 pub use frame::Frame;

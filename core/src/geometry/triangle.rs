@@ -72,7 +72,8 @@ impl Triangle {
     ///   through a shared edge hits both neighbours and the closest-hit tie rule picks one;
     /// - the segment is closed: hits at exactly `t_min` or `t_max` count;
     /// - degenerate triangles (zero area, so a zero determinant) and rays in the triangle's plane
-    ///   never hit; every comparison rejects NaN, so overflow cannot produce a hit either.
+    ///   never hit; every comparison rejects NaN, and `t` must be finite, so overflow cannot
+    ///   produce a hit either.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<TriangleHit> {
         let e1 = self.v1 - self.v0;
@@ -94,7 +95,7 @@ impl Triangle {
             return None;
         }
         let t = e2.dot(q) * inv_det;
-        (t >= ray.t_min && t <= t_max).then_some(TriangleHit { t, u, v })
+        (t >= ray.t_min && t <= t_max && t.is_finite()).then_some(TriangleHit { t, u, v })
     }
 }
 

@@ -1,0 +1,10 @@
+//! `rdbvh`: the host side of rdbvh. Loads scenes (Wavefront OBJ or built-in recipes), builds BVHs
+//! with `rdbvh-core`, traces batches of rays in parallel, and drives the `rdbvh` command line.
+//!
+//! The core crate is `no_std` so it can run in embedded renderers; everything that needs files,
+//! threads or clocks lives here, organised by the user's jobs: [`scene`] loads what to trace,
+//! [`cli`] is the command line.
+#![deny(missing_docs)]
+#![forbid(unsafe_code)]
+
+pub mod scene;

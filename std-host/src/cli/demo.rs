@@ -1,0 +1,235 @@
+//! `rdbvh` with no arguments: a short, self-checking run of the main job on built-in scenes.
+//!
+//! It does what a renderer with next event estimation does, small: build SAH and LSPH BVHs over a
+//! lit room, shoot camera-like rays and shadow rays towards the ceiling light, and check every
+//! answer against brute force, so a first run both shows the tool and proves it works here.
+
+use std::io::Write;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use rdbvh_core::brute_force;
+use rdbvh_core::geometry::{Ray, Triangle};
+use rdbvh_core::heuristics::{CostConstants, Sah};
+use rdbvh_core::Vec3;
+
+use super::builder::{BuilderArgs, BuilderKind, BuiltBvh};
+use super::trace::{trace, Answers};
+use super::{load_scene, CliError};
+use crate::scene::{Mt19937, Scene};
+
+/// Rays per query kind and scene: enough to exercise the trees, few enough to finish at once.
+const RAYS: usize = 2048;
+
+/// A batch of rays and how they are queried.
+struct Batch {
+    what: &'static str,
+    rays: Vec<Ray>,
+    any_hit: bool,
+}
+
+/// Runs the demo, writing what it does to `out`.
+pub fn run(out: &mut impl Write) -> Result<(), CliError> {
+    let w = |out: &mut dyn Write, text: String| writeln!(out, "{text}").map_err(CliError::Stdout);
+    w(
+        out,
+        "rdbvh demo: build BVHs over built-in scenes, trace rays, check them against brute force\n\
+         (run `rdbvh --help` for the build and trace commands)"
+            .into(),
+    )?;
+    let mut checked = 0;
+    for spec in ["builtin:room", "builtin:random1000"] {
+        let (scene, load_s) = load_scene(spec)?;
+        w(
+            out,
+            format!(
+                "\n{}: {} triangles, {} emissive, made in {:.2} ms",
+                scene.name,
+                scene.len(),
+                scene.emissive_count(),
+                load_s * 1e3
+            ),
+        )?;
+        w(
+            out,
+            "  builder  nodes  leaves  depth  SAH cost  build ms  Mtris/s".into(),
+        )?;
+        let mut bvhs = Vec::new();
+        for kind in [BuilderKind::Sah, BuilderKind::Lsph] {
+            let args = BuilderArgs {
+                builder: kind,
+                ..BuilderArgs::default()
+            };
+            let built = args.build(&scene.triangles)?;
+            w(out, format!("  {}", stats_row(kind, &built, scene.len())))?;
+            bvhs.push((kind, built));
+        }
+        for batch in batches(&scene) {
+            let start = Instant::now();
+            let expected = brute(&scene.triangles, &batch);
+            let brute_s = start.elapsed().as_secs_f64();
+            let mut bvh_s = 0.0;
+            for (kind, built) in &bvhs {
+                let start = Instant::now();
+                let got = trace(&built.bvh, &scene.triangles, &batch.rays, batch.any_hit);
+                if *kind == BuilderKind::Sah {
+                    bvh_s = start.elapsed().as_secs_f64();
+                }
+                if let Some(i) = first_difference(&got, &expected) {
+                    return Err(CliError::Mismatch(format!(
+                        "{} {}, {} BVH, ray {i}: {:?}",
+                        scene.name,
+                        batch.what,
+                        kind.name(),
+                        batch.rays[i]
+                    )));
+                }
+            }
+            checked += batch.rays.len();
+            w(
+                out,
+                format!(
+                    "  {} {}: {} hit, same answers as brute force (SAH BVH {:.2} ms, brute \
+                     force {:.2} ms)",
+                    batch.rays.len(),
+                    batch.what,
+                    expected.hits(),
+                    bvh_s * 1e3,
+                    brute_s * 1e3
+                ),
+            )?;
+        }
+    }
+    w(
+        out,
+        format!(
+            "\nall {checked} queries agree with brute force on both builders, on {} threads",
+            rayon::current_num_threads()
+        ),
+    )
+}
+
+fn stats_row(kind: BuilderKind, b: &BuiltBvh, triangles: usize) -> String {
+    format!(
+        "{:<7} {:>6} {:>7} {:>6} {:>9.2} {:>9.3} {:>8.2}",
+        kind.name(),
+        b.bvh.nodes().len(),
+        b.bvh.leaf_count(),
+        b.bvh.max_depth(),
+        b.bvh.estimated_cost(&Sah, CostConstants::default()),
+        b.seconds * 1e3,
+        b.mtris_per_s(triangles)
+    )
+}
+
+/// The rays of a scene: for a scene with lights, camera-like rays from inside plus shadow rays
+/// from random surface points to random points on the lights; otherwise random rays through its
+/// bounds, queried both ways.
+fn batches(scene: &Scene) -> Vec<Batch> {
+    let mut rng = Mt19937::new(2024);
+    let lights: Vec<u32> = scene.emissive_triangles().collect();
+    let b = scene.bounds;
+    // Origins uniform in the scene's bounds shrunk by 5% on every side.
+    let inside = |rng: &mut Mt19937| {
+        let u = Vec3::new(unit(rng), unit(rng), unit(rng));
+        b.min + b.extent() * (Vec3::splat(0.05) + u * 0.9)
+    };
+    let camera: Vec<Ray> = (0..RAYS)
+        .filter_map(|_| {
+            let o = inside(&mut rng);
+            Ray::new(o, sphere(&mut rng)).ok()
+        })
+        .collect();
+    if lights.is_empty() {
+        return vec![
+            Batch {
+                what: "random rays (closest hit)",
+                rays: camera.clone(),
+                any_hit: false,
+            },
+            Batch {
+                what: "random rays (any hit)",
+                rays: camera,
+                any_hit: true,
+            },
+        ];
+    }
+    let surfaces: Vec<u32> = (0..scene.len() as u32)
+        .filter(|&i| !scene.emissive[i as usize])
+        .collect();
+    let shadow: Vec<Ray> = (0..RAYS)
+        .filter_map(|_| {
+            let from = pick(&mut rng, &surfaces)
+                .map(|i| on_triangle(&mut rng, &scene.triangles[i as usize]))?;
+            let to = pick(&mut rng, &lights)
+                .map(|i| on_triangle(&mut rng, &scene.triangles[i as usize]))?;
+            // Unnormalised direction with t in (0, 1): the segment between the two points, minus
+            // a little at each end so neither endpoint's own triangle counts as an occluder.
+            Ray::segment(from, to - from, 1e-4, 1.0 - 1e-4).ok()
+        })
+        .collect();
+    vec![
+        Batch {
+            what: "camera rays (closest hit)",
+            rays: camera,
+            any_hit: false,
+        },
+        Batch {
+            what: "shadow rays to the light (any hit = occluded)",
+            rays: shadow,
+            any_hit: true,
+        },
+    ]
+}
+
+fn brute(triangles: &[Triangle], batch: &Batch) -> Answers {
+    if batch.any_hit {
+        Answers::Any(
+            batch
+                .rays
+                .par_iter()
+                .map(|r| brute_force::any_hit(r, triangles))
+                .collect(),
+        )
+    } else {
+        Answers::Closest(
+            batch
+                .rays
+                .par_iter()
+                .map(|r| brute_force::closest_hit(r, triangles))
+                .collect(),
+        )
+    }
+}
+
+fn first_difference(a: &Answers, b: &Answers) -> Option<usize> {
+    match (a, b) {
+        (Answers::Closest(a), Answers::Closest(b)) => a.iter().zip(b).position(|(x, y)| x != y),
+        (Answers::Any(a), Answers::Any(b)) => a.iter().zip(b).position(|(x, y)| x != y),
+        _ => Some(0),
+    }
+}
+
+fn unit(rng: &mut Mt19937) -> f32 {
+    rng.canonical_f64() as f32
+}
+
+/// A direction uniform on the unit sphere.
+fn sphere(rng: &mut Mt19937) -> Vec3 {
+    let z = 2.0 * unit(rng) - 1.0;
+    let phi = std::f32::consts::TAU * unit(rng);
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// A point uniform on triangle `t`.
+fn on_triangle(rng: &mut Mt19937, t: &Triangle) -> Vec3 {
+    let s = unit(rng).sqrt();
+    let r = unit(rng);
+    t.v0 * (1.0 - s) + t.v1 * (s * (1.0 - r)) + t.v2 * (s * r)
+}
+
+fn pick(rng: &mut Mt19937, ids: &[u32]) -> Option<u32> {
+    let i = (unit(rng) * ids.len() as f32) as usize;
+    ids.get(i.min(ids.len().saturating_sub(1))).copied()
+}

@@ -1,0 +1,77 @@
+//! Everything a command can fail with. The binary prints one line, `error: <Display>`, and exits
+//! non-zero, so every message must stand on its own and name the input at fault.
+
+use std::fmt;
+use std::io;
+use std::path::PathBuf;
+
+use rdbvh_core::BuildError;
+
+use super::rays::RaysError;
+use crate::scene::SceneError;
+
+/// Why a command failed.
+#[derive(Debug)]
+pub enum CliError {
+    /// The scene could not be loaded.
+    Scene(SceneError),
+    /// The BVH build rejected its input or settings.
+    Build(BuildError),
+    /// The rays file is unusable.
+    Rays(RaysError),
+    /// An output file could not be written.
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// What the operating system said.
+        source: io::Error,
+    },
+    /// Standard output could not be written.
+    Stdout(io::Error),
+    /// The demo found a BVH answer that differs from brute force: a bug, reported loudly.
+    Mismatch(String),
+}
+
+impl fmt::Display for CliError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CliError::Scene(e) => e.fmt(f),
+            CliError::Build(e) => write!(f, "BVH build failed: {e}"),
+            CliError::Rays(e) => e.fmt(f),
+            CliError::Write { path, source } => {
+                write!(f, "cannot write {}: {source}", path.display())
+            }
+            CliError::Stdout(e) => write!(f, "cannot write to standard output: {e}"),
+            CliError::Mismatch(what) => write!(f, "BVH disagrees with brute force: {what}"),
+        }
+    }
+}
+
+impl std::error::Error for CliError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            CliError::Scene(e) => Some(e),
+            CliError::Rays(e) => Some(e),
+            CliError::Write { source, .. } | CliError::Stdout(source) => Some(source),
+            CliError::Build(_) | CliError::Mismatch(_) => None,
+        }
+    }
+}
+
+impl From<SceneError> for CliError {
+    fn from(e: SceneError) -> Self {
+        CliError::Scene(e)
+    }
+}
+
+impl From<BuildError> for CliError {
+    fn from(e: BuildError) -> Self {
+        CliError::Build(e)
+    }
+}
+
+impl From<RaysError> for CliError {
+    fn from(e: RaysError) -> Self {
+        CliError::Rays(e)
+    }
+}

@@ -1,0 +1,160 @@
+//! The `rdbvh` command line: `build` and `trace` over OBJ files or built-in scenes, and a
+//! self-checking demo when run with no arguments.
+//!
+//! Output contracts are measured from outside (scripts parse `build --json` and the CSV files), so
+//! they are kept stable: see each command's documentation. Every failure is one line on standard
+//! error, `error: ...`, and a non-zero exit status: 2 for a bad command line, 1 for anything else.
+
+mod build;
+mod builder;
+mod demo;
+mod error;
+mod rays;
+mod trace;
+
+pub use build::{BuildArgs, BuildReport};
+pub use builder::{BuilderArgs, BuilderKind, BuiltBvh};
+pub use error::CliError;
+pub use rays::{parse_rays, read_rays, RaysError, OPTIONAL_COLUMNS, REQUIRED_COLUMNS};
+pub use trace::{trace, Answers, TraceArgs};
+
+use std::ffi::OsString;
+use std::io::{self, Write};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use clap::{Parser, Subcommand};
+
+use crate::scene::Scene;
+
+const SCENES_HELP: &str = "\
+Scenes: SCENE.obj is a Wavefront OBJ file (triangulated, all objects in file order; its .mtl
+gives material names and emissive flags, and a missing .mtl is only a warning), or one of:
+  builtin:random100    the thesis's Random100 (100 random triangles, std::mt19937 seed 1)
+  builtin:random1000   the thesis's Random1000 (the next 1000 triangles of that stream)
+  builtin:room         a closed room with an emissive ceiling light and three boxes
+
+Run with no arguments for a short demo that checks itself against brute force.";
+
+/// Ray-distribution-aware BVHs: build and trace over OBJ scenes.
+#[derive(Parser, Debug)]
+#[command(name = "rdbvh", version, after_help = SCENES_HELP)]
+pub struct Cli {
+    /// What to do; none runs the demo.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// The subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Build a BVH and report nodes, leaves, depth, SAH cost, memory and build speed.
+    Build(BuildArgs),
+    /// Trace rays from a CSV file and write the closest (or any) hit of each to a CSV file.
+    Trace(TraceArgs),
+}
+
+/// Runs the command line `args` (the first item is the program name) and returns the exit
+/// status. Never panics on user input: every failure is one `error: ...` line on standard error.
+pub fn main_with_args<I, T>(args: I) -> ExitCode
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    let cli = match Cli::try_parse_from(args) {
+        Ok(cli) => cli,
+        Err(e) => return usage_error(&e),
+    };
+    let stdout = io::stdout();
+    let mut out = stdout.lock();
+    let result = match &cli.command {
+        None => demo::run(&mut out),
+        Some(Command::Build(args)) => build::run(args, &mut out),
+        Some(Command::Trace(args)) => trace::run(args, &mut io::stderr()),
+    };
+    let result = result.and_then(|()| out.flush().map_err(CliError::Stdout));
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        // A closed pipe (`rdbvh build x | head -1`) is the reader's choice, not a failure.
+        Err(CliError::Stdout(e)) if e.kind() == io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Prints help and version as clap does; squeezes a usage error into one line, since scripts
+/// and users read the first line of standard error.
+fn usage_error(e: &clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    match e.kind() {
+        ErrorKind::DisplayHelp
+        | ErrorKind::DisplayVersion
+        | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            // Printing help can only fail on a closed stream, where there is no one to tell.
+            let _ = e.print();
+            ExitCode::from(if e.use_stderr() { 2 } else { 0 })
+        }
+        _ => {
+            eprintln!("{}", one_line(&e.render().to_string()));
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// clap's message without its usage block, on one line.
+fn one_line(message: &str) -> String {
+    let body = message.split("\nUsage:").next().unwrap_or(message);
+    let mut line = body
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with("For more information"))
+        .collect::<Vec<_>>()
+        .join(" ");
+    if !line.starts_with("error:") {
+        line = format!("error: {line}");
+    }
+    format!("{line} (see rdbvh --help)")
+}
+
+/// Opens a scene (a path or `builtin:NAME`), prints its warnings to standard error, and returns
+/// it with the seconds it took.
+fn load_scene(spec: &str) -> Result<(Scene, f64), CliError> {
+    let start = Instant::now();
+    let scene = Scene::open(spec)?;
+    let seconds = start.elapsed().as_secs_f64();
+    for w in &scene.warnings {
+        eprintln!("warning: {}: {w}", scene.name);
+    }
+    Ok((scene, seconds))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn usage_errors_are_one_line() {
+        for args in [
+            &["rdbvh", "build"][..],
+            &["rdbvh", "build", "x.obj", "--bins", "1"],
+            &["rdbvh", "build", "x.obj", "--builder", "median"],
+            &["rdbvh", "trace", "x.obj"],
+            &["rdbvh", "frobnicate"],
+        ] {
+            let e = Cli::try_parse_from(args).unwrap_err();
+            let line = one_line(&e.render().to_string());
+            assert!(line.starts_with("error: "), "{line}");
+            assert!(!line.contains('\n'), "{line}");
+        }
+    }
+
+    #[test]
+    fn demo_passes() {
+        let mut out = Vec::new();
+        demo::run(&mut out).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        assert!(text.contains("agree with brute force"), "{text}");
+    }
+}

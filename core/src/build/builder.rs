@@ -371,9 +371,9 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                 .then(|| BinMap::new(lo, hi, self.config.bins))
                 .flatten()
         });
-        for axis in 0..3 {
-            if maps[axis].is_some() {
-                arena.bins[axis][..nb].fill(Bin::EMPTY);
+        for (bins, map) in arena.bins.iter_mut().zip(&maps) {
+            if map.is_some() {
+                bins[..nb].fill(Bin::EMPTY);
             }
         }
         let refs = &arena.refs;

@@ -105,9 +105,9 @@ impl BuildConfig {
             }
         }
         let k = self.constants;
-        if !(k.traversal.is_finite() && k.traversal >= 0.0)
-            || !(k.intersection.is_finite() && k.intersection > 0.0)
-        {
+        let traversal_ok = k.traversal.is_finite() && k.traversal >= 0.0;
+        let intersection_ok = k.intersection.is_finite() && k.intersection > 0.0;
+        if !(traversal_ok && intersection_ok) {
             return Err(BuildError::InvalidConfig(
                 "cost constants must be finite, C_trav >= 0 and C_isect > 0",
             ));

@@ -104,7 +104,8 @@ impl Bvh {
     /// instead of the root's measure, so rays that miss the root count as costing nothing, as they
     /// do when rays are traced. Zero for an empty BVH or a non-positive `total`.
     pub fn estimated_cost_over(&self, model: &impl CostModel, k: CostConstants, total: f32) -> f32 {
-        if self.nodes.is_empty() || !(total > 0.0) {
+        // NaN fails `total > 0.0` too.
+        if self.nodes.is_empty() || total.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
             return 0.0;
         }
         let sum: f64 = self

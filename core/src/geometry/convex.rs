@@ -69,7 +69,8 @@ fn project(points: &[Vec3], axis: Vec3) -> (f32, f32) {
 fn no_separating_axis(a: &[Vec3], b: &[Vec3], axes: impl Iterator<Item = Vec3>, tol: f32) -> bool {
     for axis in axes {
         let len2 = axis.length_squared();
-        if !(len2 > 1e-20) {
+        // Parallel edges give a zero axis; NaN axes are skipped too.
+        if len2.is_nan() || len2 <= 1e-20 {
             continue;
         }
         let (a_lo, a_hi) = project(a, axis);

@@ -1,0 +1,448 @@
+//! The composite scene: influence areas with local BVHs, an area lookup, and a fallback BVH.
+
+use alloc::vec::Vec;
+use core::fmt;
+
+use super::{AreaList, AreaLookup, BreakEven, Octree};
+use crate::build::{BuildArena, Preset, PresetError, PresetOptions};
+use crate::bvh::{Bvh, Hit, TraversalStats};
+use crate::geometry::{Ray, Triangle};
+use crate::heuristics::CostConstants;
+use crate::influence::InfluenceArea;
+
+/// How far before an area's exit the fallback search starts, relative to the exit distance: the
+/// local BVH has already answered everything up to the exit, and the overlap keeps a hit exactly
+/// at the boundary from falling between the two searches under rounding.
+const EXIT_OVERLAP: f32 = 1e-5;
+
+/// How a [`Scene`] is built.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneOptions {
+    /// The preset of every local BVH.
+    pub preset: Preset,
+    /// Settings of the local builds.
+    pub local: PresetOptions,
+    /// Settings of the fallback build (always the `sah` preset).
+    pub fallback: PresetOptions,
+    /// How many affine areas a query tries before falling back (the thesis used 1).
+    pub max_tries: u32,
+}
+
+impl Default for SceneOptions {
+    fn default() -> Self {
+        Self {
+            preset: Preset::Full,
+            local: PresetOptions::default(),
+            fallback: PresetOptions::default(),
+            max_tries: 1,
+        }
+    }
+}
+
+/// Why a scene could not be built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SceneError {
+    /// A local BVH failed to build.
+    Local {
+        /// The area.
+        area: u32,
+        /// Why.
+        error: PresetError,
+    },
+    /// The fallback BVH failed to build.
+    Fallback(PresetError),
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SceneError::Local { area, error } => write!(f, "local BVH of area {area}: {error}"),
+            SceneError::Fallback(e) => write!(f, "fallback BVH: {e}"),
+        }
+    }
+}
+
+/// What one query through the scene did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SceneStats {
+    /// Affine areas whose local BVH was traversed.
+    pub tries: u32,
+    /// The area whose local BVH answered, if one did.
+    pub answered_by: Option<u32>,
+    /// True when the fallback BVH was traversed.
+    pub fell_back: bool,
+    /// Work in local BVHs.
+    pub local: TraversalStats,
+    /// Work in the fallback BVH.
+    pub fallback: TraversalStats,
+}
+
+impl SceneStats {
+    /// Total cost: local plus fallback work.
+    pub fn cost(&self, k: CostConstants) -> f32 {
+        self.local.cost(k) + self.fallback.cost(k)
+    }
+}
+
+/// Influence areas, their local BVHs, an area lookup `L` and the fallback BVH.
+///
+/// A query finds the candidate areas of its origin, tries up to `max_tries` affine ones, and
+/// traverses each one's local BVH over the part of the segment inside the area, `[t_min, t_exit]`.
+/// A local hit is accepted only there (a closer triangle just outside the area cannot exist: the
+/// segment up to `t_exit` lies inside the area, and every triangle meeting the area is in its
+/// local BVH by the exact separating-axis test). Otherwise the fallback BVH answers the rest of the
+/// segment. Every answer equals the brute-force one.
+#[derive(Clone, Debug)]
+pub struct Scene<L: AreaLookup = Octree> {
+    areas: Vec<InfluenceArea>,
+    local: Vec<Bvh>,
+    triangles_per_area: Vec<u32>,
+    fallback: Bvh,
+    lookup: L,
+    max_tries: u32,
+}
+
+impl Scene<Octree> {
+    /// A scene over `tris` with an octree of `levels` levels.
+    pub fn with_octree(
+        tris: &[Triangle],
+        areas: Vec<InfluenceArea>,
+        options: &SceneOptions,
+        levels: u32,
+    ) -> Result<Self, SceneError> {
+        Self::build(tris, areas, options, |a| Octree::build(a, levels))
+    }
+}
+
+impl Scene<AreaList> {
+    /// A scene over `tris` with the naive area list.
+    pub fn with_list(
+        tris: &[Triangle],
+        areas: Vec<InfluenceArea>,
+        options: &SceneOptions,
+    ) -> Result<Self, SceneError> {
+        Self::build(tris, areas, options, |a| AreaList::new(a.len()))
+    }
+}
+
+impl<L: AreaLookup> Scene<L> {
+    /// Builds the local BVHs (one arena for all), the fallback BVH and the lookup.
+    pub fn build(
+        tris: &[Triangle],
+        areas: Vec<InfluenceArea>,
+        options: &SceneOptions,
+        lookup: impl FnOnce(&[InfluenceArea]) -> L,
+    ) -> Result<Self, SceneError> {
+        let mut arena = BuildArena::with_capacity(tris.len());
+        let mut local = Vec::with_capacity(areas.len());
+        let mut triangles_per_area = Vec::with_capacity(areas.len());
+        for (i, area) in areas.iter().enumerate() {
+            let fail = |error| SceneError::Local {
+                area: i as u32,
+                error,
+            };
+            let bounds = area.bounds();
+            let inside = (0..tris.len() as u32).filter(|&t| {
+                let tri = &tris[t as usize];
+                // The box test rejects most triangles cheaply; the SAT test is exact.
+                !tri.bounds().intersection(bounds).is_empty() && area.overlaps_triangle(tri)
+            });
+            arena
+                .load_triangle_subset(tris, inside)
+                .map_err(|e| fail(e.into()))?;
+            triangles_per_area.push(arena.len() as u32);
+            let mut bvh = Bvh::with_capacity(arena.len());
+            options
+                .preset
+                .build_into(Some(area), &options.local, &mut arena, &mut bvh)
+                .map_err(fail)?;
+            local.push(bvh);
+        }
+        arena
+            .load_triangles(tris)
+            .map_err(|e| SceneError::Fallback(e.into()))?;
+        let mut fallback = Bvh::with_capacity(tris.len());
+        Preset::Sah
+            .build_into(None, &options.fallback, &mut arena, &mut fallback)
+            .map_err(SceneError::Fallback)?;
+        let lookup = lookup(&areas);
+        Ok(Self {
+            areas,
+            local,
+            triangles_per_area,
+            fallback,
+            lookup,
+            max_tries: options.max_tries,
+        })
+    }
+
+    /// The influence areas.
+    pub fn areas(&self) -> &[InfluenceArea] {
+        &self.areas
+    }
+
+    /// The local BVH of each area.
+    pub fn local_bvhs(&self) -> &[Bvh] {
+        &self.local
+    }
+
+    /// How many triangles each area's local BVH holds.
+    pub fn triangles_per_area(&self) -> &[u32] {
+        &self.triangles_per_area
+    }
+
+    /// The fallback BVH.
+    pub fn fallback(&self) -> &Bvh {
+        &self.fallback
+    }
+
+    /// The area lookup.
+    pub fn lookup(&self) -> &L {
+        &self.lookup
+    }
+
+    /// Bytes of every BVH, the lookup and the areas.
+    pub fn memory_bytes(&self) -> usize {
+        self.local.iter().map(Bvh::memory_bytes).sum::<usize>()
+            + self.fallback.memory_bytes()
+            + self.lookup.memory_bytes()
+            + self.areas.len() * core::mem::size_of::<InfluenceArea>()
+    }
+
+    /// The local segments to search: for each of up to `max_tries` affine candidate areas whose
+    /// part of the segment starts at `t_min` (the origin is inside), the area and its exit.
+    #[inline]
+    fn affine_segments<'a>(&'a self, ray: &'a Ray) -> impl Iterator<Item = (u32, f32)> + 'a {
+        self.lookup
+            .candidates(ray.origin)
+            .iter()
+            .filter_map(move |&a| {
+                let area = &self.areas[a as usize];
+                if !area.is_affine(ray) {
+                    return None;
+                }
+                let (t0, t1) = area.polytope().clip_ray(ray)?;
+                (t0 <= ray.t_min).then_some((a, t1))
+            })
+            .take(self.max_tries as usize)
+    }
+
+    /// The closest hit, exactly as brute force finds it.
+    pub fn closest_hit(&self, ray: &Ray, tris: &[Triangle]) -> Option<Hit> {
+        self.closest_hit_with_stats(ray, tris, &mut SceneStats::default())
+    }
+
+    /// [`Scene::closest_hit`], recording what it did in `stats`.
+    pub fn closest_hit_with_stats(
+        &self,
+        ray: &Ray,
+        tris: &[Triangle],
+        stats: &mut SceneStats,
+    ) -> Option<Hit> {
+        let mut searched_to = ray.t_min;
+        for (a, t_exit) in self.affine_segments(ray) {
+            stats.tries += 1;
+            let segment = Ray {
+                t_max: t_exit.min(ray.t_max),
+                ..*ray
+            };
+            if let Some(hit) =
+                self.local[a as usize].closest_hit_with_stats(&segment, tris, &mut stats.local)
+            {
+                stats.answered_by = Some(a);
+                return Some(hit);
+            }
+            searched_to = searched_to.max(t_exit - t_exit.abs() * EXIT_OVERLAP);
+        }
+        stats.fell_back = true;
+        let rest = Ray {
+            t_min: searched_to,
+            ..*ray
+        };
+        self.fallback
+            .closest_hit_with_stats(&rest, tris, &mut stats.fallback)
+    }
+
+    /// True when anything is hit on the segment, exactly as brute force says.
+    pub fn any_hit(&self, ray: &Ray, tris: &[Triangle]) -> bool {
+        self.any_hit_with_stats(ray, tris, &mut SceneStats::default())
+    }
+
+    /// [`Scene::any_hit`], recording what it did in `stats`.
+    pub fn any_hit_with_stats(&self, ray: &Ray, tris: &[Triangle], stats: &mut SceneStats) -> bool {
+        let mut searched_to = ray.t_min;
+        for (a, t_exit) in self.affine_segments(ray) {
+            stats.tries += 1;
+            let segment = Ray {
+                t_max: t_exit.min(ray.t_max),
+                ..*ray
+            };
+            if self.local[a as usize].any_hit_with_stats(&segment, tris, &mut stats.local) {
+                stats.answered_by = Some(a);
+                return true;
+            }
+            searched_to = searched_to.max(t_exit - t_exit.abs() * EXIT_OVERLAP);
+        }
+        stats.fell_back = true;
+        let rest = Ray {
+            t_min: searched_to,
+            ..*ray
+        };
+        self.fallback
+            .any_hit_with_stats(&rest, tris, &mut stats.fallback)
+    }
+
+    /// The break-even measurement for area `area` over `rays`: its local hit rate, the local and
+    /// fallback closest-hit costs, and the cost through the structure.
+    pub fn break_even(
+        &self,
+        area: usize,
+        rays: impl IntoIterator<Item = Ray>,
+        tris: &[Triangle],
+        k: CostConstants,
+    ) -> BreakEven {
+        let mut out = BreakEven::default();
+        let (mut hits, mut local, mut global, mut structure) = (0u32, 0f64, 0f64, 0f64);
+        for ray in rays {
+            out.rays += 1;
+            let mut s = SceneStats::default();
+            self.closest_hit_with_stats(&ray, tris, &mut s);
+            if s.answered_by == Some(area as u32) {
+                hits += 1;
+            }
+            local += f64::from(s.local.cost(k));
+            structure += f64::from(s.cost(k));
+            let mut g = TraversalStats::default();
+            self.fallback.closest_hit_with_stats(&ray, tris, &mut g);
+            global += f64::from(g.cost(k));
+        }
+        if out.rays > 0 {
+            let n = f64::from(out.rays);
+            out.hit_rate = hits as f32 / out.rays as f32;
+            out.cost_local = (local / n) as f32;
+            out.cost_global = (global / n) as f32;
+            out.cost_structure = (structure / n) as f32;
+        }
+        out
+    }
+
+    /// Keeps only the areas `keep` accepts (by index), rebuilding the lookup: for dropping the
+    /// areas whose [`BreakEven`] says they do not pay off.
+    pub fn retain_areas(&mut self, keep: impl Fn(usize) -> bool) {
+        let mask: Vec<bool> = (0..self.areas.len()).map(keep).collect();
+        retain_by_mask(&mut self.areas, &mask);
+        retain_by_mask(&mut self.local, &mask);
+        retain_by_mask(&mut self.triangles_per_area, &mask);
+        self.lookup = self.lookup.rebuilt(&self.areas);
+    }
+}
+
+/// Keeps the elements whose `mask` entry is true.
+fn retain_by_mask<T>(v: &mut Vec<T>, mask: &[bool]) {
+    let mut keep = mask.iter();
+    v.retain(|_| keep.next().copied().unwrap_or(false));
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::brute_force;
+    use crate::influence::{PlaneArea, PointArea, RaySampler};
+    use crate::random::Pcg32;
+
+    fn soup(n: usize, seed: u64) -> Vec<Triangle> {
+        let mut rng = Pcg32::new(seed);
+        let mut v = || {
+            Vec3::new(
+                rng.range(0.0, 10.0),
+                rng.range(0.0, 10.0),
+                rng.range(0.0, 10.0),
+            )
+        };
+        (0..n)
+            .map(|_| {
+                let a = v();
+                Triangle::new(
+                    a,
+                    a + (v() - Vec3::splat(5.0)) * 0.3,
+                    a + (v() - Vec3::splat(5.0)) * 0.3,
+                )
+            })
+            .collect()
+    }
+
+    fn areas() -> Vec<InfluenceArea> {
+        alloc::vec![
+            PlaneArea::new(Vec3::new(5.0, 5.0, 2.0), Vec3::Z, 3.0, 3.0, 4.0)
+                .unwrap()
+                .into(),
+            PointArea::new(
+                Vec3::new(5.0, 12.0, 5.0),
+                Vec3::new(0.0, -1.0, 0.1),
+                60.0,
+                60.0,
+                1.0,
+                8.0
+            )
+            .unwrap()
+            .into(),
+        ]
+    }
+
+    #[test]
+    fn queries_equal_brute_force_for_affine_and_other_rays() {
+        let tris = soup(800, 2);
+        let options = SceneOptions::default();
+        let octree = Scene::with_octree(&tris, areas(), &options, 5).unwrap();
+        let list = Scene::with_list(&tris, areas(), &options).unwrap();
+        let mut rng = Pcg32::new(4);
+        let mut local_answers = 0;
+        for (i, area) in areas().into_iter().enumerate() {
+            let mut sampler = RaySampler::new(area, i as u64);
+            for j in 0..2000 {
+                let mut ray = sampler.sample();
+                if j % 3 == 1 {
+                    // Almost affine: a little off the area's direction.
+                    ray = Ray::new(ray.origin, ray.dir + Vec3::splat(0.02)).unwrap();
+                } else if j % 3 == 2 {
+                    let d = Vec3::new(
+                        rng.range(-1.0, 1.0),
+                        rng.range(-1.0, 1.0),
+                        rng.range(-1.0, 1.0),
+                    );
+                    let Ok(r) = Ray::new(ray.origin + Vec3::Z, d) else {
+                        continue;
+                    };
+                    ray = r;
+                }
+                let expect = brute_force::closest_hit(&ray, &tris);
+                let mut s = SceneStats::default();
+                assert_eq!(octree.closest_hit_with_stats(&ray, &tris, &mut s), expect);
+                local_answers += usize::from(s.answered_by.is_some());
+                assert_eq!(list.closest_hit(&ray, &tris), expect);
+                assert_eq!(octree.any_hit(&ray, &tris), expect.is_some());
+                assert_eq!(list.any_hit(&ray, &tris), expect.is_some());
+            }
+        }
+        assert!(
+            local_answers > 500,
+            "local BVHs answered only {local_answers} rays"
+        );
+    }
+
+    #[test]
+    fn break_even_and_retain() {
+        let tris = soup(800, 3);
+        let mut scene = Scene::with_octree(&tris, areas(), &SceneOptions::default(), 5).unwrap();
+        let rays: Vec<Ray> = RaySampler::new(scene.areas()[0], 1).take(2000).collect();
+        let be = scene.break_even(0, rays, &tris, CostConstants::default());
+        assert_eq!(be.rays, 2000);
+        assert!(be.cost_global > 0.0 && be.cost_local > 0.0);
+        assert!((0.0..=1.0).contains(&be.hit_rate));
+        scene.retain_areas(|i| i == 1);
+        assert_eq!(scene.areas().len(), 1);
+        assert_eq!(scene.local_bvhs().len(), 1);
+    }
+}

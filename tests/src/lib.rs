@@ -10,7 +10,7 @@
 use std::path::PathBuf;
 
 use rdbvh_core::brute_force;
-use rdbvh_core::bvh::{Bvh, TraversalStats};
+use rdbvh_core::bvh::{AllHitStats, Bvh, Hit, TraversalStats};
 use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 use rdbvh_core::Vec3;
 
@@ -141,33 +141,23 @@ pub fn interior_rays(bounds: &Aabb, count: usize, seed: u64) -> Vec<Ray> {
         .collect()
 }
 
-/// Which open core bug (each reproduced by an ignored test in `tests/core_bugs.rs`) a ray runs
-/// into, if any, so that property tests can set those rays aside by name instead of loosening their
-/// assertions. Remove a case here when the core fixes it.
+/// Which open core bug (each reproduced by an ignored `CORE BUG` test in
+/// `tests/core_regressions.rs`) a ray runs into, if any, so the property tests can set those rays
+/// aside by name instead of loosening their assertions. Remove the case when the core fixes it.
 pub fn known_core_bug(ray: &Ray, tris: &[Triangle]) -> Option<&'static str> {
-    for tri in tris {
-        let Some(h) = tri.intersect(ray, ray.t_max) else {
-            continue;
-        };
-        if !h.t.is_finite() {
-            // Moller-Trumbore's `t` overflowed to an infinity and was accepted as a hit.
-            return Some("core_bug_infinite_t_hit");
-        }
-        // The triangle test's hit must pass the box test of the triangle's own box at that `t`
-        // (then it passes every enclosing node's too, the slab test being monotonic in the box).
-        // When it does not, the two core tests disagree through rounding and the BVH cannot find
-        // the hit, whatever its structure.
+    tris.iter().find_map(|tri| {
+        let h = tri.intersect(ray, ray.t_max)?;
+        // The hit must pass the box test of the triangle's own padded box (as BVH nodes store
+        // it) at that very `t`; then it passes every enclosing node's too. An ill-conditioned
+        // Moller-Trumbore `t` (a ray nearly in the triangle's plane, or a tiny triangle far from
+        // the ray origin) can put the hit point far outside, where no BVH can find it.
         let at_hit = Ray::segment(ray.origin, ray.dir, h.t, h.t).ok()?;
-        if tri.bounds().intersect(&at_hit, h.t).is_none() {
-            return Some("core_bug_rounding_hit_outside_triangle_box");
-        }
-        // A hit before the (padded) entry of its triangle's own box: the ordered closest-hit walk
-        // may prune the subtree holding it after an equally close (or farther by rounding) hit.
-        if h.t < tri.bounds().slab_interval(ray, ray.t_max).0 {
-            return Some("core_bug_ordered_prune_breaks_tie_rule");
-        }
-    }
-    None
+        tri.bounds()
+            .padded()
+            .intersect(&at_hit, h.t)
+            .is_none()
+            .then_some("core_bug_ill_conditioned_hit_outside_its_box")
+    })
 }
 
 /// Counters of a comparison run, for a test's report and its sanity checks.
@@ -179,14 +169,46 @@ pub struct Agreement {
     pub hits: usize,
 }
 
+/// The brute-force answers for one ray, computed once and compared against any number of BVHs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Oracle {
+    /// The closest hit over all triangles.
+    pub closest: Option<Hit>,
+    /// Whether any triangle is hit.
+    pub any: bool,
+    /// How many triangles are hit.
+    pub count: u32,
+}
+
+impl Oracle {
+    /// Asks the brute-force oracle about `ray`.
+    pub fn new(ray: &Ray, tris: &[Triangle]) -> Self {
+        Self {
+            closest: brute_force::closest_hit(ray, tris),
+            any: brute_force::any_hit(ray, tris),
+            count: brute_force::hit_count(ray, tris),
+        }
+    }
+}
+
 /// Checks one ray against the oracle: the closest hit is exactly the oracle's, any-hit agrees with
 /// it, the all-hit walk counts exactly the oracle's hits and tests at least that many triangles,
 /// and the traversal counters are consistent with the tree. Returns the closest hit.
 ///
 /// # Panics
 /// On the first disagreement, naming the ray.
-pub fn check_ray(bvh: &Bvh, tris: &[Triangle], ray: &Ray) -> Option<rdbvh_core::bvh::Hit> {
-    let expect = brute_force::closest_hit(ray, tris);
+pub fn check_ray(bvh: &Bvh, tris: &[Triangle], ray: &Ray) -> Option<Hit> {
+    check_ray_against(bvh, tris, ray, &Oracle::new(ray, tris))
+}
+
+/// [`check_ray`] with the oracle's answers already known.
+pub fn check_ray_against(bvh: &Bvh, tris: &[Triangle], ray: &Ray, oracle: &Oracle) -> Option<Hit> {
+    assert_eq!(
+        oracle.any,
+        oracle.closest.is_some(),
+        "the oracle's own answers disagree for {ray:?}"
+    );
+    let expect = oracle.closest;
     let mut cs = TraversalStats::default();
     let got = bvh.closest_hit_with_stats(ray, tris, &mut cs);
     assert_eq!(
@@ -201,27 +223,44 @@ pub fn check_ray(bvh: &Bvh, tris: &[Triangle], ray: &Ray) -> Option<rdbvh_core::
     let mut anys = TraversalStats::default();
     let any = bvh.any_hit_with_stats(ray, tris, &mut anys);
     assert_eq!(
-        any,
-        brute_force::any_hit(ray, tris),
+        any, oracle.any,
         "any hit differs from brute force for {ray:?}"
-    );
-    assert_eq!(
-        any,
-        expect.is_some(),
-        "any hit and closest hit disagree for {ray:?}"
     );
     assert_eq!(bvh.any_hit(ray, tris), any);
     let all = bvh.all_hit(ray, tris);
     assert_eq!(
-        all.hits,
-        brute_force::hit_count(ray, tris),
+        all.hits, oracle.count,
         "all-hit count differs from brute force for {ray:?}"
     );
+    check_traversal_consistency(bvh, tris, ray, (got, &cs), (any, &anys), &all);
+    expect
+}
+
+/// The checks that need no oracle: any-hit agrees with closest-hit, the all-hit walk saw at least
+/// the closest hit, each walk's counters are within the tree, and the ordered and early-exit walks
+/// never do more than the exhaustive one.
+pub fn check_traversal_consistency(
+    bvh: &Bvh,
+    _tris: &[Triangle],
+    ray: &Ray,
+    (closest, cs): (Option<Hit>, &TraversalStats),
+    (any, anys): (bool, &TraversalStats),
+    all: &AllHitStats,
+) {
+    assert_eq!(
+        any,
+        closest.is_some(),
+        "any hit and closest hit disagree for {ray:?}"
+    );
     assert!(all.triangles >= all.hits, "{all:?} for {ray:?}");
-    check_stats_sane(bvh, &cs, expect.is_some(), ray);
-    check_stats_sane(bvh, &anys, any, ray);
-    // The ordered and the early-exit walks never do more than the exhaustive one.
-    for s in [&cs, &anys] {
+    assert_eq!(
+        all.hits > 0,
+        any,
+        "all-hit {all:?} vs any hit {any} for {ray:?}"
+    );
+    check_stats_sane(bvh, cs, closest.is_some(), ray);
+    check_stats_sane(bvh, anys, any, ray);
+    for s in [cs, anys] {
         assert!(
             s.inner_nodes <= all.inner_nodes
                 && s.leaves <= all.leaves
@@ -229,7 +268,17 @@ pub fn check_ray(bvh: &Bvh, tris: &[Triangle], ray: &Ray) -> Option<rdbvh_core::
             "traversal {s:?} did more than the all-hit walk {all:?} for {ray:?}"
         );
     }
-    expect
+}
+
+/// Runs every traversal on `ray` and checks them against each other (no oracle).
+pub fn check_ray_consistency(bvh: &Bvh, tris: &[Triangle], ray: &Ray) -> Option<Hit> {
+    let mut cs = TraversalStats::default();
+    let closest = bvh.closest_hit_with_stats(ray, tris, &mut cs);
+    let mut anys = TraversalStats::default();
+    let any = bvh.any_hit_with_stats(ray, tris, &mut anys);
+    let all = bvh.all_hit(ray, tris);
+    check_traversal_consistency(bvh, tris, ray, (closest, &cs), (any, &anys), &all);
+    closest
 }
 
 /// Counters of one closest-hit or any-hit query: within the tree's size, leaves visited only if
@@ -286,7 +335,11 @@ pub fn check_structure(bvh: &Bvh, tris: &[Triangle]) {
     assert_eq!(bvh.prim_indices().len(), tris.len());
     assert!(bvh.max_depth() <= rdbvh_core::bvh::MAX_DEPTH);
     if !tris.is_empty() {
-        let root = bvh.bounds();
-        assert!(root.contains_box(&scene_bounds(tris)) && scene_bounds(tris).contains_box(&root));
+        // Nodes store their exact boxes padded by a hair (`Aabb::padded`), never more.
+        let (root, exact) = (bvh.bounds(), scene_bounds(tris));
+        assert!(
+            root.contains_box(&exact) && exact.padded().contains_box(&root),
+            "root box {root:?} is not the scene's box {exact:?}, padded"
+        );
     }
 }

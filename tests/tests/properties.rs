@@ -9,7 +9,7 @@
 use proptest::prelude::*;
 use proptest::sample::Index;
 use rdbvh_core::brute_force;
-use rdbvh_core::build::{BuildArena, BuildConfig, Builder};
+use rdbvh_core::build::{BinSpace, BuildArena, BuildConfig, Builder, CutEvaluation, ThesisCut};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::{Ray, RayError, Triangle};
 use rdbvh_core::heuristics::{
@@ -249,8 +249,7 @@ fn check_builder<A: AxisChooser, C: CostModel, T: Termination>(
 /// The rays of a case, in the scaled scene, plus segments that end or start exactly on each
 /// closest hit (the segment is closed, so the hit must survive).
 ///
-/// Set aside, by name, until the core fixes them (`tests/core_bugs.rs`): rays that meet an open
-/// core bug ([`known_core_bug`]).
+/// Rays that meet an open core bug ([`known_core_bug`]) are set aside by name until it is fixed.
 fn resolve_rays(specs: &[RaySpec], tris: &[Triangle], s: f32) -> Vec<Ray> {
     let mut rays = Vec::new();
     for spec in specs {
@@ -281,6 +280,19 @@ fn resolve_rays(specs: &[RaySpec], tris: &[Triangle], s: f32) -> Vec<Ray> {
     rays
 }
 
+/// Every cut evaluation and bin placement the skeleton offers.
+fn cut_and_space() -> impl Strategy<Value = (CutEvaluation, BinSpace)> {
+    (
+        prop_oneof![
+            Just(CutEvaluation::BestOfAxes),
+            Just(CutEvaluation::FirstAxis),
+            Just(CutEvaluation::Thesis(ThesisCut::LSPH)),
+            Just(CutEvaluation::Thesis(ThesisCut::SPFH)),
+        ],
+        prop_oneof![Just(BinSpace::Centroids), Just(BinSpace::NodeBox)],
+    )
+}
+
 fn thesis_builder(bins: u32, max_depth: u32) -> Builder<AllAxes, Sah, LeafSize> {
     Builder::new(
         AllAxes,
@@ -305,6 +317,7 @@ proptest! {
         specs in prop::collection::vec(ray_spec(), 1..40),
         bins in prop_oneof![Just(2u32), Just(3), Just(4), Just(7), Just(16), Just(64)],
         s in scale(),
+        (cut, bin_space) in cut_and_space(),
     ) {
         // The scene's scale comes with the scene; `s` only scales free ray origins, so rays also
         // start far inside or far outside the scene.
@@ -313,13 +326,11 @@ proptest! {
         check_builder(&Builder::sah(), &tris, &rays, &mut arena);
         check_builder(&Builder::lsph(), &tris, &rays, &mut arena);
         check_builder(&thesis_builder(bins, rdbvh_core::bvh::MAX_DEPTH), &tris, &rays, &mut arena);
-        let lsph_bins = Builder::new(
-            LongestAxis,
-            Sah,
-            SahTermination { max_leaf: 4 },
-            BuildConfig { bins, ..BuildConfig::default() },
-        );
+        let config = BuildConfig { bins, cut, bin_space, ..BuildConfig::default() };
+        let lsph_bins = Builder::new(LongestAxis, Sah, SahTermination { max_leaf: 4 }, config);
         check_builder(&lsph_bins, &tris, &rays, &mut arena);
+        let all_axes = Builder::new(AllAxes, Sah, LeafSize { max_leaf: 1 }, config);
+        check_builder(&all_axes, &tris, &rays, &mut arena);
     }
 
     /// A shallow depth bound forces big leaves and median splits; the tree stays valid, within
@@ -363,15 +374,15 @@ proptest! {
         check_builder(&Builder::sah(), &tris, &rays, &mut arena);
     }
 
-    /// An infinite vertex coordinate anywhere is a typed error naming that triangle, never a
-    /// panic. (NaN: see `core_bug_nan_vertex_is_rejected` in `tests/core_bugs.rs`.)
+    /// A NaN or infinite vertex coordinate anywhere is a typed error naming that triangle, never
+    /// a panic.
     #[test]
-    fn infinite_vertices_are_rejected(
+    fn non_finite_vertices_are_rejected(
         tris in prop::collection::vec(triangle(), 1..20),
         which in any::<Index>(),
         vertex in 0usize..3,
         axis in 0usize..3,
-        bad in prop_oneof![Just(f32::INFINITY), Just(f32::NEG_INFINITY)],
+        bad in prop_oneof![Just(f32::NAN), Just(f32::INFINITY), Just(f32::NEG_INFINITY)],
     ) {
         let mut tris = tris;
         let i = which.index(tris.len());

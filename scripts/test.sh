@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# The project's one test command (the README's `bash scripts/test.sh`; CI runs it through .ci/run
+# with CI=true). On a fresh machine it installs what it needs, then checks formatting, lints, runs
+# every test in release, and proves the core builds for a bare-metal target.
+#
+# With CI=true, the real-scene tests fail instead of skipping when ../shared is missing.
+#
+# Extension points: add a section with `section "name"` followed by its commands; sections run in
+# order and stop at the first failure (set -e). The fuzz section below is the hook for bounded
+# fuzz runs (FUZZ_SECONDS per target) once fuzz/ exists.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+TARGET=thumbv7em-none-eabihf
+CONSUMER=tests/no-std-consumer
+FUZZ_SECONDS=${FUZZ_SECONDS:-60}
+LOG_DIR=$(mktemp -d)
+trap 'rm -rf "$LOG_DIR"' EXIT
+
+section() {
+    printf '\n==> %s\n' "$1"
+}
+
+section "toolchain"
+rustup component add clippy rustfmt
+rustup target add "$TARGET"
+rustc --version
+cargo --version
+
+section "format (cargo fmt --check)"
+cargo fmt --all -- --check
+cargo fmt --manifest-path "$CONSUMER/Cargo.toml" -- --check
+
+section "lints (cargo clippy -D warnings)"
+cargo clippy --workspace --all-targets -- -D warnings
+cargo clippy --manifest-path "$CONSUMER/Cargo.toml" --target "$TARGET" -- -D warnings
+
+section "tests (cargo test --workspace --release)"
+cargo test --workspace --release 2>&1 | tee "$LOG_DIR/test.log"
+
+section "no_std: rdbvh-core for $TARGET"
+cargo build -p rdbvh-core --release --target "$TARGET"
+
+section "no_std: consumer staticlib for $TARGET"
+cargo build --manifest-path "$CONSUMER/Cargo.toml" --release --target "$TARGET"
+lib="$CONSUMER/target/$TARGET/release/librdbvh_no_std_consumer.a"
+# The consumer must really link the core's build and traversal, not be an empty crate.
+if command -v nm >/dev/null; then
+    nm "$lib" 2>/dev/null >"$LOG_DIR/nm.txt" || true
+    for symbol in rdbvh_demo 'rdbvh_core.*closest_hit' 'rdbvh_core.*any_hit' 'rdbvh_core.*BuildArena'; do
+        if ! grep -q "$symbol" "$LOG_DIR/nm.txt"; then
+            echo "error: $lib has no symbol matching '$symbol'" >&2
+            exit 1
+        fi
+    done
+    echo "staticlib links the core's builder and traversals: $lib"
+else
+    echo "note: nm not found, symbol check not run"
+fi
+
+section "fuzz (bounded)"
+if [[ -d fuzz ]] && command -v cargo-fuzz >/dev/null; then
+    for target in $(cargo fuzz list); do
+        cargo fuzz run "$target" -- -max_total_time="$FUZZ_SECONDS"
+    done
+else
+    echo "no fuzz/ targets yet (or cargo-fuzz not installed): nothing to run"
+fi
+
+section "summary"
+passed=$(grep -Eo '^test result: ok\. [0-9]+ passed' "$LOG_DIR/test.log" | awk '{s += $4} END {print s + 0}')
+ignored=$(grep -Eo '[0-9]+ ignored' "$LOG_DIR/test.log" | awk '{s += $1} END {print s + 0}')
+echo "ignored tests (open bugs, see tests/tests/core_regressions.rs): $ignored"
+echo "tests: $passed passed, 0 failed"

@@ -29,6 +29,7 @@ pub mod geometry;
 pub mod heuristics;
 pub mod influence;
 pub mod random;
+pub mod simd;
 pub mod toplevel;
 
 pub use error::BuildError;

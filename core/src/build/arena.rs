@@ -3,10 +3,12 @@
 use alloc::vec::Vec;
 
 use glam::Vec3;
+use wide::f32x4;
 
 use super::config::MAX_BINS;
 use crate::bvh::MAX_DEPTH;
 use crate::geometry::{Aabb, Triangle};
+use crate::simd::Aabb4;
 use crate::BuildError;
 
 /// Primitive references as a structure of arrays: the binning loop streams through the bounds, and
@@ -74,18 +76,101 @@ impl PrimRefs {
     }
 }
 
-/// One bin of a sweep: how many centroids fell in it and the bounds of their primitives.
+/// One bin of a sweep: how many centroids fell in it and the bounds of their primitives, kept as
+/// 4-wide lanes `(x, y, z, 0)` so growing it by a primitive is one `minps` and one `maxps`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Bin {
-    pub bounds: Aabb,
+    pub min: f32x4,
+    pub max: f32x4,
     pub count: u32,
 }
 
 impl Bin {
     pub const EMPTY: Bin = Bin {
-        bounds: Aabb::EMPTY,
+        min: f32x4::splat(f32::INFINITY),
+        max: f32x4::splat(f32::NEG_INFINITY),
         count: 0,
     };
+
+    /// Adds a primitive's bounds (finite lanes, so the NaN-unaware min/max are exact).
+    #[inline(always)]
+    pub fn grow(&mut self, lo: f32x4, hi: f32x4) {
+        self.min = self.min.fast_min(lo);
+        self.max = self.max.fast_max(hi);
+        self.count += 1;
+    }
+
+    /// Adds another bin.
+    #[inline(always)]
+    pub fn merge(&mut self, other: &Bin) {
+        self.min = self.min.fast_min(other.min);
+        self.max = self.max.fast_max(other.max);
+        self.count += other.count;
+    }
+}
+
+/// One side of every bin boundary of a sweep, as SoA lanes: boundary `i`'s box and count. Padded
+/// by three lanes so the last group of four can always be loaded.
+#[derive(Debug)]
+pub(crate) struct SweepSide {
+    min: [[f32; SWEEP_LANES]; 3],
+    max: [[f32; SWEEP_LANES]; 3],
+    pub count: [u32; SWEEP_LANES],
+}
+
+const SWEEP_LANES: usize = MAX_BINS as usize + 4;
+
+impl SweepSide {
+    const fn new() -> Self {
+        Self {
+            min: [[0.0; SWEEP_LANES]; 3],
+            max: [[0.0; SWEEP_LANES]; 3],
+            count: [0; SWEEP_LANES],
+        }
+    }
+
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, bin: &Bin) {
+        let (lo, hi) = (bin.min.to_array(), bin.max.to_array());
+        for k in 0..3 {
+            self.min[k][i] = lo[k];
+            self.max[k][i] = hi[k];
+        }
+        self.count[i] = bin.count;
+    }
+
+    #[inline(always)]
+    pub fn bounds(&self, i: usize) -> Aabb {
+        Aabb::new(
+            Vec3::new(self.min[0][i], self.min[1][i], self.min[2][i]),
+            Vec3::new(self.max[0][i], self.max[1][i], self.max[2][i]),
+        )
+    }
+
+    /// The measures and counts of boundaries `i..i + 4`.
+    #[inline(always)]
+    pub fn lanes<M: crate::heuristics::CostModel>(&self, i: usize, model: &M) -> (f32x4, f32x4) {
+        let lane = |a: &[f32; SWEEP_LANES]| -> [f32; 4] { [a[i], a[i + 1], a[i + 2], a[i + 3]] };
+        let b4 = Aabb4::load(
+            &[lane(&self.min[0]), lane(&self.min[1]), lane(&self.min[2])],
+            &[lane(&self.max[0]), lane(&self.max[1]), lane(&self.max[2])],
+        );
+        let c = &self.count;
+        let n = f32x4::from([
+            c[i] as f32,
+            c[i + 1] as f32,
+            c[i + 2] as f32,
+            c[i + 3] as f32,
+        ]);
+        (model.measure4(&b4), n)
+    }
+}
+
+/// Scratch of one axis's sweep: both sides of every boundary.
+#[derive(Debug)]
+pub(crate) struct Sweep {
+    pub left: SweepSide,
+    pub right: SweepSide,
 }
 
 /// A node waiting to be processed: its exact bounds, slot range, depth and centroid bounds
@@ -109,6 +194,7 @@ pub(crate) struct Task {
 pub struct BuildArena {
     pub(crate) refs: PrimRefs,
     pub(crate) bins: [[Bin; MAX_BINS as usize]; 3],
+    pub(crate) sweep: Sweep,
     pub(crate) tasks: Vec<Task>,
     pub(crate) bounds: Aabb,
     pub(crate) centroids: Aabb,
@@ -121,6 +207,10 @@ impl BuildArena {
         Self {
             refs: PrimRefs::with_capacity(capacity),
             bins: [[Bin::EMPTY; MAX_BINS as usize]; 3],
+            sweep: Sweep {
+                left: SweepSide::new(),
+                right: SweepSide::new(),
+            },
             // The builder descends into one child and defers the other, so pending tasks are at
             // most one per level.
             tasks: Vec::with_capacity(MAX_DEPTH as usize + 2),

@@ -1,8 +1,10 @@
 //! The build skeleton: choose axes, bin, sweep, then stop or split. Heuristics are type parameters.
 
-use super::arena::{Bin, BuildArena, PrimRefs, Task};
-use super::config::{BinSpace, BuildConfig, CutEvaluation, MAX_BINS};
+use super::arena::{Bin, BuildArena, PrimRefs, Sweep, Task};
+use super::config::{BinSpace, BuildConfig, CutEvaluation};
 use crate::bvh::{Bvh, BvhNode};
+use wide::f32x4;
+
 use crate::geometry::{Aabb, Triangle};
 use crate::heuristics::{
     AllAxes, AxisChooser, CostModel, LongestAxis, Sah, SahTermination, Termination,
@@ -290,6 +292,17 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         Some(partition(arena, task, &best))
     }
 
+    /// Bins for a node of `count` primitives. Centroid bins adapt to small nodes (`count` bins, at
+    /// least 4): more bins than centroids only add empty boundaries to sweep, and small nodes are
+    /// most of the tree. Node-box planes stay as configured, as the thesis placed them.
+    #[inline]
+    fn bins_for(&self, count: u32) -> u32 {
+        match self.config.bin_space {
+            BinSpace::Centroids => self.config.bins.min(count.max(4)),
+            BinSpace::NodeBox => self.config.bins,
+        }
+    }
+
     /// Bins the node along the axes the cut evaluation needs, then applies it with `model`.
     fn choose<M: CostModel>(
         &self,
@@ -308,23 +321,32 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             // The fallback needs the longest axis whatever the chooser said.
             CutEvaluation::Thesis(_) => binned = [true; 3],
         }
-        let maps = self.bin(arena, task, bounds, binned);
-        let nb = self.config.bins;
-        let arena = &*arena;
+        let nb = self.bins_for(task.count);
+        let maps = self.bin(arena, task, bounds, binned, nb);
+        let nb = nb as usize;
+        let BuildArena { bins, sweep, .. } = arena;
+        let mut sweep_axis =
+            |axis: usize, model: &M| sweep_axis(&bins[axis][..nb], sweep, axis, maps[axis]?, model);
         match self.config.cut {
-            CutEvaluation::BestOfAxes => order
-                .iter()
-                .filter_map(|(axis, _)| sweep_axis(arena, axis, maps[axis]?, nb, model))
-                .min_by(|a, b| a.weighted.total_cmp(&b.weighted)),
-            CutEvaluation::FirstAxis => sweep_axis(arena, first, maps[first]?, nb, model),
+            CutEvaluation::BestOfAxes => {
+                let mut best: Option<Split> = None;
+                for (axis, _) in order.iter() {
+                    if let Some(s) = sweep_axis(axis, model) {
+                        if best.is_none_or(|b| s.weighted < b.weighted) {
+                            best = Some(s);
+                        }
+                    }
+                }
+                best
+            }
+            CutEvaluation::FirstAxis => sweep_axis(first, model),
             CutEvaluation::Thesis(cut) => {
                 let mut best: Option<Split> = None;
                 for (i, (axis, quality)) in order.iter().enumerate() {
                     if i > 0 && quality < cut.quality_threshold {
                         break;
                     }
-                    let candidate = maps[axis].and_then(|m| sweep_axis(arena, axis, m, nb, model));
-                    if let Some(s) = candidate {
+                    if let Some(s) = sweep_axis(axis, model) {
                         if best.is_none_or(|b| s.weighted < b.weighted) {
                             best = Some(s);
                         }
@@ -339,7 +361,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                     _ => {
                         let axis = bounds.largest_axis();
                         maps[axis]
-                            .and_then(|m| sweep_axis(arena, axis, m, nb, &Sah))
+                            .and_then(|m| self::sweep_axis(&bins[axis][..nb], sweep, axis, m, &Sah))
                             .or(best)
                     }
                 }
@@ -355,8 +377,8 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         task: &Task,
         bounds: &Aabb,
         axes: [bool; 3],
+        nb: u32,
     ) -> [Option<BinMap>; 3] {
-        let nb = self.config.bins as usize;
         let maps: [Option<BinMap>; 3] = core::array::from_fn(|axis| {
             if !axes[axis] {
                 return None;
@@ -368,23 +390,39 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             };
             // A node box with extent but coincident centroids cannot be split by any plane.
             (task.centroids.max[axis] > task.centroids.min[axis])
-                .then(|| BinMap::new(lo, hi, self.config.bins))
+                .then(|| BinMap::new(lo, hi, nb))
                 .flatten()
         });
         for (bins, map) in arena.bins.iter_mut().zip(&maps) {
             if map.is_some() {
-                bins[..nb].fill(Bin::EMPTY);
+                bins[..nb as usize].fill(Bin::EMPTY);
             }
         }
+        // All three axes' bin indices in one 4-wide evaluation; an axis that is not binned gets
+        // scale 0, so bin 0, and is skipped. The arithmetic is `BinMap::bin`'s, lane by lane, so
+        // the partition classifies every primitive exactly as the bins counted it.
+        let lane = |f: fn(&BinMap) -> f32| {
+            f32x4::from([
+                maps[0].as_ref().map_or(0.0, f),
+                maps[1].as_ref().map_or(0.0, f),
+                maps[2].as_ref().map_or(0.0, f),
+                0.0,
+            ])
+        };
+        let (min, scale, last) = (lane(|m| m.min), lane(|m| m.scale), lane(|m| m.last));
+        let active = [maps[0].is_some(), maps[1].is_some(), maps[2].is_some()];
         let refs = &arena.refs;
         for i in task.start as usize..(task.start + task.count) as usize {
-            let b = refs.bounds(i);
-            let c = b.min + b.max;
-            for (axis, map) in maps.iter().enumerate() {
-                if let Some(map) = map {
-                    let bin = &mut arena.bins[axis][map.bin(c[axis])];
-                    bin.count += 1;
-                    bin.bounds = bin.bounds.union(b);
+            let lo = f32x4::from([refs.lo[0][i], refs.lo[1][i], refs.lo[2][i], 0.0]);
+            let hi = f32x4::from([refs.hi[0][i], refs.hi[1][i], refs.hi[2][i], 0.0]);
+            let index = ((lo + hi - min) * scale)
+                .fast_max(f32x4::ZERO)
+                .fast_min(last)
+                .fast_trunc_int()
+                .to_array();
+            for axis in 0..3 {
+                if active[axis] {
+                    arena.bins[axis][index[axis] as usize].grow(lo, hi);
                 }
             }
         }
@@ -392,52 +430,56 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
     }
 }
 
-/// The cheapest boundary of one binned axis under `model`: a suffix sweep stores the right
-/// sides' measures and counts, a prefix sweep prices every boundary. O(bins).
+/// The cheapest boundary of one binned axis under `model`. A suffix and a prefix pass write the
+/// boxes and counts on both sides of every boundary into SoA scratch lanes; the boundaries are
+/// then priced four at a time with [`CostModel::measure4`]. O(bins), no allocation.
 fn sweep_axis<M: CostModel>(
-    arena: &BuildArena,
+    bins: &[Bin],
+    sweep: &mut Sweep,
     axis: usize,
     map: BinMap,
-    bins: u32,
     model: &M,
 ) -> Option<Split> {
-    let bins = &arena.bins[axis][..bins as usize];
     let nb = bins.len();
-    let mut right_box = [Aabb::EMPTY; MAX_BINS as usize];
-    let mut right_m = [0.0f32; MAX_BINS as usize];
-    let mut right_n = [0u32; MAX_BINS as usize];
+    // Boundary i (1..nb) separates bins[..i] from bins[i..]; lanes past nb - 1 get empty sides.
     let mut acc = Bin::EMPTY;
     for i in (1..nb).rev() {
-        acc.bounds = acc.bounds.union(bins[i].bounds);
-        acc.count += bins[i].count;
-        right_box[i] = acc.bounds;
-        right_m[i] = model.measure(&acc.bounds);
-        right_n[i] = acc.count;
+        acc.merge(&bins[i]);
+        sweep.right.set(i, &acc);
     }
-    let mut best: Option<Split> = None;
-    let mut left = Bin::EMPTY;
+    acc = Bin::EMPTY;
     for i in 1..nb {
-        left.bounds = left.bounds.union(bins[i - 1].bounds);
-        left.count += bins[i - 1].count;
-        if left.count == 0 || right_n[i] == 0 {
-            continue;
-        }
-        let weighted =
-            model.measure(&left.bounds) * left.count as f32 + right_m[i] * right_n[i] as f32;
-        if weighted.is_finite() && best.is_none_or(|b| weighted < b.weighted) {
-            best = Some(Split {
-                axis,
-                map,
-                bin: i,
-                left: left.bounds,
-                right: right_box[i],
-                n_left: left.count,
-                n_right: right_n[i],
-                weighted,
-            });
+        acc.merge(&bins[i - 1]);
+        sweep.left.set(i, &acc);
+    }
+    for i in nb..nb + 3 {
+        sweep.left.set(i, &Bin::EMPTY);
+        sweep.right.set(i, &Bin::EMPTY);
+    }
+    let mut best: Option<(f32, usize)> = None;
+    for i in (1..nb).step_by(4) {
+        let (ml, nl) = sweep.left.lanes(i, model);
+        let (mr, nr) = sweep.right.lanes(i, model);
+        let weighted = (ml * nl + mr * nr).to_array();
+        for (j, &w) in weighted.iter().enumerate() {
+            let b = i + j;
+            let valid = b < nb && sweep.left.count[b] > 0 && sweep.right.count[b] > 0;
+            if valid && w.is_finite() && best.is_none_or(|(bw, _)| w < bw) {
+                best = Some((w, b));
+            }
         }
     }
-    best
+    let (weighted, bin) = best?;
+    Some(Split {
+        axis,
+        map,
+        bin,
+        left: sweep.left.bounds(bin),
+        right: sweep.right.bounds(bin),
+        n_left: sweep.left.count[bin],
+        n_right: sweep.right.count[bin],
+        weighted,
+    })
 }
 
 /// `ceil(log2(n))` for `n >= 1`.
@@ -451,18 +493,30 @@ fn ceil_log2(n: u32) -> u32 {
 fn partition(arena: &mut BuildArena, task: &Task, split: &Split) -> (Child, Child) {
     let refs = &mut arena.refs;
     let axis = split.axis;
-    let (mut i, mut j) = (task.start as usize, (task.start + task.count) as usize);
+    let goes_left =
+        |refs: &PrimRefs, i: usize| split.map.bin(refs.centroid2_axis(i, axis)) < split.bin;
+    // Hoare's scheme: only misplaced pairs are swapped. The child centroid bounds are gathered as
+    // each slot settles on its side.
     let (mut left_c, mut right_c) = (Aabb::EMPTY, Aabb::EMPTY);
-    while i < j {
-        let c = refs.centroid2(i);
-        if split.map.bin(c[axis]) < split.bin {
-            left_c = left_c.grown(c);
+    let (mut i, mut j) = (task.start as usize, (task.start + task.count) as usize);
+    loop {
+        while i < j && goes_left(refs, i) {
+            left_c = left_c.grown(refs.centroid2(i));
             i += 1;
-        } else {
-            right_c = right_c.grown(c);
-            j -= 1;
-            refs.swap(i, j);
         }
+        while i < j && !goes_left(refs, j - 1) {
+            j -= 1;
+            right_c = right_c.grown(refs.centroid2(j));
+        }
+        if i >= j {
+            break;
+        }
+        // Slot i belongs right and slot j - 1 left: swap them into place.
+        j -= 1;
+        refs.swap(i, j);
+        left_c = left_c.grown(refs.centroid2(i));
+        right_c = right_c.grown(refs.centroid2(j));
+        i += 1;
     }
     debug_assert_eq!(i as u32 - task.start, split.n_left);
     (

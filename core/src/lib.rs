@@ -21,6 +21,7 @@
 
 extern crate alloc;
 
+pub mod analyze;
 pub mod brute_force;
 pub mod build;
 pub mod bvh;

@@ -5,25 +5,25 @@
 //! timed build includes bounding the triangles, which every builder must do. Outputs are dropped
 //! outside the timing (`iter_with_large_drop`), so freeing a tree is not counted against anyone.
 
+mod clock;
+
 use std::hint::black_box;
 use std::time::Duration;
 
+use clock::Clock;
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use rdbvh_benches::peers::{BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Rdbvh};
 use rdbvh_benches::{load_scene, RdbvhReuse, BENCH_SCENES};
 use rdbvh_core::geometry::Triangle;
 
-fn bench_library<L: Library>(
-    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
-    tris: &[Triangle],
-) {
+fn bench_library<L: Library>(group: &mut criterion::BenchmarkGroup<'_, Clock>, tris: &[Triangle]) {
     let mut scene = L::scene(tris);
     group.bench_function(L::NAME, |b| {
         b.iter_with_large_drop(|| L::build(black_box(&mut scene)))
     });
 }
 
-fn builds(c: &mut Criterion) {
+fn builds(c: &mut Criterion<Clock>) {
     for name in BENCH_SCENES {
         let tris = match load_scene(name) {
             Ok(t) => t,
@@ -55,5 +55,9 @@ fn builds(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, builds);
+criterion_group! {
+    name = benches;
+    config = Criterion::default().with_measurement(Clock::from_env());
+    targets = builds
+}
 criterion_main!(benches);

@@ -5,10 +5,12 @@
 //! the run stops if any library agrees on fewer than [`MIN_AGREEMENT`] of the rays: a speed
 //! measured on wrong answers means nothing. The agreement rates are printed with the results.
 
+mod clock;
+
 use std::hint::black_box;
 use std::time::Duration;
 
-use criterion::measurement::WallTime;
+use clock::Clock;
 use criterion::{
     criterion_group, criterion_main, BenchmarkGroup, Criterion, SamplingMode, Throughput,
 };
@@ -51,7 +53,7 @@ impl<L: Library> Subject<L> {
         Self { prepared, rays }
     }
 
-    fn bench(&self, group: &mut BenchmarkGroup<'_, WallTime>, kind: RayKind, any: bool) {
+    fn bench(&self, group: &mut BenchmarkGroup<'_, Clock>, kind: RayKind, any: bool) {
         let rays = &self.rays.iter().find(|(k, _)| *k == kind).expect("set").1;
         group.bench_function(L::NAME, |b| {
             if any {
@@ -63,7 +65,7 @@ impl<L: Library> Subject<L> {
     }
 }
 
-fn traversals(c: &mut Criterion) {
+fn traversals(c: &mut Criterion<Clock>) {
     for name in BENCH_SCENES {
         let tris = match load_scene(name) {
             Ok(t) => t,
@@ -108,5 +110,9 @@ fn traversals(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, traversals);
+criterion_group! {
+    name = benches;
+    config = Criterion::default().with_measurement(Clock::from_env());
+    targets = traversals
+}
 criterion_main!(benches);

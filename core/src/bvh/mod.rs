@@ -4,12 +4,15 @@
 mod node;
 mod traverse;
 mod validate;
+mod wide;
+mod wide_traverse;
 
 use alloc::vec::Vec;
 
 pub use node::BvhNode;
 pub use traverse::{AllHitStats, Hit, TraversalStats};
 pub use validate::InvariantError;
+pub use wide::{WideBvh, WideNode};
 
 use crate::geometry::Aabb;
 use crate::heuristics::{CostConstants, CostModel};

@@ -1,6 +1,6 @@
 //! Traversal of a binary BVH: closest hit, any hit and the all-hit cost, each over a fixed stack.
 
-use super::{Bvh, BvhNode, MAX_DEPTH};
+use super::{Bvh, MAX_DEPTH};
 use crate::geometry::{pad_far, Ray, Triangle};
 use crate::heuristics::CostConstants;
 
@@ -72,43 +72,43 @@ impl AllHitStats {
 /// plus at most the one child about to be popped.
 const STACK_SIZE: usize = MAX_DEPTH as usize + 1;
 
-struct Stack<T: Copy> {
-    items: [T; STACK_SIZE],
+pub(crate) struct Stack<T: Copy, const N: usize = STACK_SIZE> {
+    items: [T; N],
     len: usize,
 }
 
-impl<T: Copy> Stack<T> {
+impl<T: Copy, const N: usize> Stack<T, N> {
     #[inline]
-    fn new(fill: T) -> Self {
+    pub(crate) fn new(fill: T) -> Self {
         Self {
-            items: [fill; STACK_SIZE],
+            items: [fill; N],
             len: 0,
         }
     }
     #[inline]
-    fn push(&mut self, item: T) {
+    pub(crate) fn push(&mut self, item: T) {
         self.items[self.len] = item;
         self.len += 1;
     }
     #[inline]
-    fn pop(&mut self) -> Option<T> {
+    pub(crate) fn pop(&mut self) -> Option<T> {
         self.len = self.len.checked_sub(1)?;
         Some(self.items[self.len])
     }
 }
 
+/// Tests the triangles `ids` and keeps the closest hit in `best` (shared by the binary and wide
+/// traversals, so both apply the same tie rule).
 #[inline]
-fn test_leaf(
-    bvh: &Bvh,
-    node: &BvhNode,
+pub(crate) fn test_prims(
+    ids: &[u32],
     ray: &Ray,
     tris: &[Triangle],
     best: &mut Option<Hit>,
     stats: &mut TraversalStats,
 ) {
     stats.leaves += 1;
-    let first = node.left_first as usize;
-    for &id in &bvh.prim_indices[first..first + node.count as usize] {
+    for &id in ids {
         let Some(tri) = tris.get(id as usize) else {
             continue;
         };
@@ -126,6 +126,27 @@ fn test_leaf(
             }
         }
     }
+}
+
+/// True when one of the triangles `ids` is hit on the segment.
+#[inline]
+pub(crate) fn any_prim(
+    ids: &[u32],
+    ray: &Ray,
+    tris: &[Triangle],
+    stats: &mut TraversalStats,
+) -> bool {
+    stats.leaves += 1;
+    for &id in ids {
+        let Some(tri) = tris.get(id as usize) else {
+            continue;
+        };
+        stats.triangles += 1;
+        if tri.intersect(ray, ray.t_max).is_some() {
+            return true;
+        }
+    }
+    false
 }
 
 impl Bvh {
@@ -148,12 +169,14 @@ impl Bvh {
         let root = self.nodes.first()?;
         root.bounds().intersect(ray, ray.t_max)?;
         let mut best: Option<Hit> = None;
-        let mut stack = Stack::new((0u32, 0.0f32));
+        let mut stack: Stack<_> = Stack::new((0u32, 0.0f32));
         let mut index = 0u32;
         loop {
             let node = &self.nodes[index as usize];
             if node.is_leaf() {
-                test_leaf(self, node, ray, tris, &mut best, stats);
+                let first = node.left_first as usize;
+                let ids = &self.prim_indices[first..first + node.count as usize];
+                test_prims(ids, ray, tris, &mut best, stats);
             } else {
                 stats.inner_nodes += 1;
                 let t_max = best.map_or(ray.t_max, |h| h.t);
@@ -212,21 +235,19 @@ impl Bvh {
         if root.bounds().intersect(ray, ray.t_max).is_none() {
             return false;
         }
-        let mut stack = Stack::new(0u32);
+        let mut stack: Stack<_> = Stack::new(0u32);
         stack.push(0);
         while let Some(index) = stack.pop() {
             let node = &self.nodes[index as usize];
             if node.is_leaf() {
-                stats.leaves += 1;
                 let first = node.left_first as usize;
-                for &id in &self.prim_indices[first..first + node.count as usize] {
-                    let Some(tri) = tris.get(id as usize) else {
-                        continue;
-                    };
-                    stats.triangles += 1;
-                    if tri.intersect(ray, ray.t_max).is_some() {
-                        return true;
-                    }
+                if any_prim(
+                    &self.prim_indices[first..first + node.count as usize],
+                    ray,
+                    tris,
+                    stats,
+                ) {
+                    return true;
                 }
             } else {
                 stats.inner_nodes += 1;
@@ -262,7 +283,7 @@ impl Bvh {
         if root.bounds().intersect(ray, ray.t_max).is_none() {
             return stats;
         }
-        let mut stack = Stack::new(0u32);
+        let mut stack: Stack<_> = Stack::new(0u32);
         stack.push(0);
         while let Some(index) = stack.pop() {
             let node = &self.nodes[index as usize];

@@ -1,0 +1,250 @@
+//! Traversal of 4-wide BVHs: one 4-wide slab test per node, nearest children first.
+
+use wide::f32x4;
+
+use super::traverse::{any_prim, test_prims, Stack};
+use super::wide::{WideBvh, WideNode};
+use super::{Hit, TraversalStats, MAX_DEPTH};
+use crate::geometry::{pad_far, Ray, Triangle};
+
+/// Each visited node pops one entry and pushes at most four, so pending entries grow by at most
+/// three per level of the (at most [`MAX_DEPTH`] deep) tree.
+const WIDE_STACK: usize = 3 * MAX_DEPTH as usize + 4;
+
+/// The slab test's relative padding (see `Aabb::slab_interval`), as a vector.
+const PAD: f32 = 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+
+/// A ray prepared for 4-wide box tests: splatted origin and inverse direction, and per axis
+/// whether the near plane is the lower bound.
+struct Ray4 {
+    origin: [f32x4; 3],
+    inv: [f32x4; 3],
+    near_is_min: [bool; 3],
+    t_min: f32x4,
+}
+
+impl Ray4 {
+    #[inline(always)]
+    fn new(ray: &Ray) -> Self {
+        let s = |v: f32| f32x4::splat(v);
+        Self {
+            origin: [s(ray.origin.x), s(ray.origin.y), s(ray.origin.z)],
+            inv: [s(ray.inv_dir.x), s(ray.inv_dir.y), s(ray.inv_dir.z)],
+            near_is_min: [
+                ray.inv_dir.x >= 0.0,
+                ray.inv_dir.y >= 0.0,
+                ray.inv_dir.z >= 0.0,
+            ],
+            t_min: s(ray.t_min),
+        }
+    }
+
+    /// Entry distances of the four children and the bitmask of those the segment up to `t_max`
+    /// touches. Same arithmetic as the scalar `Aabb::slab_interval`: the accumulator is the left
+    /// operand of `max`/`min`, which drop a NaN right operand (a zero direction component with
+    /// the origin on a slab plane), and the interval is padded after Ize.
+    #[inline(always)]
+    fn intersect(&self, node: &WideNode, t_max: f32) -> (f32x4, u32) {
+        let mut t_near = self.t_min;
+        let mut t_far = f32x4::splat(t_max);
+        for k in 0..3 {
+            let (near, far) = if self.near_is_min[k] {
+                (node.min[k], node.max[k])
+            } else {
+                (node.max[k], node.min[k])
+            };
+            t_near = t_near.max((f32x4::from(near) - self.origin[k]) * self.inv[k]);
+            t_far = t_far.min((f32x4::from(far) - self.origin[k]) * self.inv[k]);
+        }
+        let pad = f32x4::splat(PAD);
+        let t_near = t_near - t_near.abs() * pad;
+        let t_far = t_far + t_far.abs() * pad;
+        (t_near, t_near.simd_le(t_far).to_bitmask())
+    }
+}
+
+/// A pending child: node index or first primitive slot, primitive count (0 for a node), entry.
+type Entry = (u32, u32, f32);
+
+impl WideBvh {
+    /// The closest hit on `[ray.t_min, ray.t_max]`, exactly as the binary BVH and brute force
+    /// find it.
+    #[inline]
+    pub fn closest_hit(&self, ray: &Ray, tris: &[Triangle]) -> Option<Hit> {
+        self.closest_hit_with_stats(ray, tris, &mut TraversalStats::default())
+    }
+
+    /// [`WideBvh::closest_hit`], adding what it did to `stats` (a wide node counts as one inner
+    /// node).
+    pub fn closest_hit_with_stats(
+        &self,
+        ray: &Ray,
+        tris: &[Triangle],
+        stats: &mut TraversalStats,
+    ) -> Option<Hit> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        let r = Ray4::new(ray);
+        let mut best: Option<Hit> = None;
+        let mut stack: Stack<Entry, WIDE_STACK> = Stack::new((0, 0, 0.0));
+        stack.push((0, 0, ray.t_min));
+        while let Some((child, count, t_entry)) = stack.pop() {
+            if best.is_some_and(|b| t_entry > pad_far(b.t)) {
+                continue;
+            }
+            if count > 0 {
+                let first = child as usize;
+                test_prims(
+                    &self.prim_indices[first..first + count as usize],
+                    ray,
+                    tris,
+                    &mut best,
+                    stats,
+                );
+                continue;
+            }
+            stats.inner_nodes += 1;
+            let node = &self.nodes[child as usize];
+            let (t_near, mut mask) = r.intersect(node, best.map_or(ray.t_max, |h| h.t));
+            let t_near = t_near.to_array();
+            // Hit children sorted by entry, nearest last, so it is popped first.
+            let mut hits = [(0usize, 0.0f32); 4];
+            let mut n = 0;
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let mut j = n;
+                while j > 0 && hits[j - 1].1 < t_near[i] {
+                    hits[j] = hits[j - 1];
+                    j -= 1;
+                }
+                hits[j] = (i, t_near[i]);
+                n += 1;
+            }
+            for &(i, t) in &hits[..n] {
+                stack.push((node.child[i], node.count[i], t));
+            }
+        }
+        best
+    }
+
+    /// True when any triangle is hit on the segment; stops at the first hit.
+    #[inline]
+    pub fn any_hit(&self, ray: &Ray, tris: &[Triangle]) -> bool {
+        self.any_hit_with_stats(ray, tris, &mut TraversalStats::default())
+    }
+
+    /// [`WideBvh::any_hit`], adding what it did to `stats`.
+    pub fn any_hit_with_stats(
+        &self,
+        ray: &Ray,
+        tris: &[Triangle],
+        stats: &mut TraversalStats,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let r = Ray4::new(ray);
+        let mut stack: Stack<(u32, u32), WIDE_STACK> = Stack::new((0, 0));
+        stack.push((0, 0));
+        while let Some((child, count)) = stack.pop() {
+            if count > 0 {
+                let first = child as usize;
+                if any_prim(
+                    &self.prim_indices[first..first + count as usize],
+                    ray,
+                    tris,
+                    stats,
+                ) {
+                    return true;
+                }
+                continue;
+            }
+            stats.inner_nodes += 1;
+            let node = &self.nodes[child as usize];
+            let (_, mut mask) = r.intersect(node, ray.t_max);
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                stack.push((node.child[i], node.count[i]));
+            }
+        }
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use alloc::vec::Vec;
+
+    use glam::Vec3;
+
+    use super::*;
+    use crate::brute_force;
+    use crate::build::Builder;
+    use crate::bvh::Bvh;
+    use crate::random::Pcg32;
+
+    #[test]
+    fn wide_agrees_with_brute_force() {
+        let mut rng = Pcg32::new(21);
+        let mut v = |s: f32| Vec3::new(rng.range(-s, s), rng.range(-s, s), rng.range(-s, s));
+        let mut tris: Vec<Triangle> = (0..700)
+            .map(|_| {
+                let a = v(10.0);
+                Triangle::new(a, a + v(1.0), a + v(1.0))
+            })
+            .collect();
+        // Axis-aligned walls: rays along their faces exercise the NaN lanes.
+        tris.push(Triangle::new(
+            Vec3::new(-20.0, -20.0, 0.0),
+            Vec3::new(20.0, -20.0, 0.0),
+            Vec3::new(0.0, 20.0, 0.0),
+        ));
+        for n in [1usize, 2, 5, tris.len()] {
+            let tris = &tris[..n];
+            let bvh = Builder::sah().build(tris).unwrap();
+            let wide = WideBvh::from_binary(&bvh);
+            assert!(wide.max_depth() <= bvh.max_depth());
+            for i in 0..2000 {
+                let o = v(12.0);
+                let mut d = v(1.0);
+                if i % 4 == 0 {
+                    d = Vec3::new(d.x, 0.0, -0.0);
+                }
+                if i % 8 == 1 {
+                    // Along the wall's plane.
+                    let o = Vec3::new(o.x, o.y, 0.0);
+                    let Ok(r) = Ray::new(o, Vec3::new(d.x, d.y, 0.0)) else {
+                        continue;
+                    };
+                    assert_eq!(
+                        wide.closest_hit(&r, tris),
+                        brute_force::closest_hit(&r, tris)
+                    );
+                    continue;
+                }
+                let Ok(r) = Ray::new(o, d) else { continue };
+                let expect = brute_force::closest_hit(&r, tris);
+                assert_eq!(wide.closest_hit(&r, tris), expect, "ray {i}");
+                assert_eq!(wide.any_hit(&r, tris), expect.is_some());
+            }
+        }
+    }
+
+    #[test]
+    fn empty_and_single_leaf() {
+        let wide = WideBvh::from_binary(&Bvh::default());
+        let r = Ray::new(Vec3::ZERO, Vec3::Z).unwrap();
+        assert!(wide.closest_hit(&r, &[]).is_none());
+        let t = [Triangle::new(
+            Vec3::new(-1.0, -1.0, 1.0),
+            Vec3::new(1.0, -1.0, 1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        )];
+        let wide = WideBvh::from_binary(&Builder::sah().build(&t).unwrap());
+        assert_eq!(wide.closest_hit(&r, &t).unwrap().triangle, 0);
+        assert!(wide.any_hit(&r, &t));
+    }
+}

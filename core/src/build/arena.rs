@@ -235,6 +235,12 @@ impl BuildArena {
         self.refs.ids.is_empty()
     }
 
+    /// The id and bounds in primitive slot `slot` (in the order a build left them), or `None`
+    /// past the loaded primitives.
+    pub fn prim(&self, slot: usize) -> Option<(u32, Aabb)> {
+        (slot < self.len()).then(|| (self.refs.ids[slot], self.refs.bounds(slot)))
+    }
+
     /// Forgets the loaded primitives, keeping the memory.
     pub fn clear(&mut self) {
         self.refs.clear();

@@ -3,6 +3,8 @@
 use super::arena::{Bin, BuildArena, PrimRefs, Sweep, Task};
 use super::config::{BinSpace, BuildConfig, CutEvaluation};
 use crate::bvh::{Bvh, BvhNode};
+use alloc::vec::Vec;
+
 use wide::f32x4;
 
 use crate::geometry::{Aabb, Triangle};
@@ -10,6 +12,20 @@ use crate::heuristics::{
     AllAxes, AxisChooser, CostModel, LongestAxis, Sah, SahTermination, Termination,
 };
 use crate::BuildError;
+
+/// A subtree left for a separate build by [`Builder::build_top`]: the placeholder leaf `node`
+/// over primitive slots `start..start + count`, at depth `depth`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Subtree {
+    /// The placeholder node.
+    pub node: u32,
+    /// First primitive slot.
+    pub start: u32,
+    /// Number of primitives.
+    pub count: u32,
+    /// Depth of the subtree's root in the whole tree.
+    pub depth: u32,
+}
 
 /// What a build produced, besides the BVH.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -174,6 +190,45 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         arena: &mut BuildArena,
         out: &mut Bvh,
     ) -> Result<BuildStats, BuildError> {
+        self.build_range(arena, out, 0, 0, None)
+    }
+
+    /// [`Builder::build_into`] for a subtree whose root sits at depth `depth` of a larger tree, so
+    /// the depth bound and every depth-dependent decision are those of the whole build: the result
+    /// is exactly the subtree the whole build would make from these primitives.
+    pub fn build_subtree_into(
+        &self,
+        arena: &mut BuildArena,
+        out: &mut Bvh,
+        depth: u32,
+    ) -> Result<BuildStats, BuildError> {
+        self.build_range(arena, out, depth, 0, None)
+    }
+
+    /// The top of a build, for threaded builders: like [`Builder::build_into`], but a node of at
+    /// most `cutoff` primitives is not processed; it stays a leaf over its slot range in `out` and
+    /// is recorded in `jobs`, in the order the single-threaded build would have reached it. Build
+    /// each job's primitives ([`BuildArena::prim`]) with [`Builder::build_subtree_into`] at the
+    /// job's depth and graft the results to get the single-threaded tree.
+    pub fn build_top(
+        &self,
+        arena: &mut BuildArena,
+        out: &mut Bvh,
+        cutoff: u32,
+        jobs: &mut Vec<Subtree>,
+    ) -> Result<BuildStats, BuildError> {
+        jobs.clear();
+        self.build_range(arena, out, 0, cutoff, Some(jobs))
+    }
+
+    fn build_range(
+        &self,
+        arena: &mut BuildArena,
+        out: &mut Bvh,
+        depth: u32,
+        cutoff: u32,
+        mut jobs: Option<&mut Vec<Subtree>>,
+    ) -> Result<BuildStats, BuildError> {
         self.config.validate()?;
         let n = arena.len();
         out.nodes.clear();
@@ -193,13 +248,30 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             bounds: arena.bounds,
             start: 0,
             count: n as u32,
-            depth: 0,
+            depth,
             centroids: arena.centroids,
         };
         loop {
             stats.max_depth = stats.max_depth.max(task.depth);
-            match self.split(arena, &task, &task.bounds, &mut stats) {
-                None => stats.leaves += 1,
+            let deferred = match jobs.as_deref_mut() {
+                Some(jobs) if task.count <= cutoff => {
+                    jobs.push(Subtree {
+                        node: task.node,
+                        start: task.start,
+                        count: task.count,
+                        depth: task.depth,
+                    });
+                    true
+                }
+                _ => false,
+            };
+            let decided = if deferred {
+                None
+            } else {
+                self.split(arena, &task, &task.bounds, &mut stats)
+            };
+            match decided {
+                None => stats.leaves += u32::from(!deferred),
                 Some((left, right)) => {
                     let l = out.nodes.len() as u32;
                     out.nodes[task.node as usize].left_first = l;

@@ -8,9 +8,11 @@
 mod arena;
 mod builder;
 mod config;
+mod graft;
 mod preset;
 
 pub use arena::BuildArena;
-pub use builder::{BuildStats, Builder};
+pub use builder::{BuildStats, Builder, Subtree};
 pub use config::{BinSpace, BuildConfig, CutEvaluation, ThesisCut, MAX_BINS};
+pub use graft::GraftError;
 pub use preset::{AreaPah, Preset, PresetError, PresetOptions};

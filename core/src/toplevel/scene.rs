@@ -96,7 +96,6 @@ impl SceneStats {
 pub struct Scene<L: AreaLookup = Octree> {
     areas: Vec<InfluenceArea>,
     local: Vec<Bvh>,
-    triangles_per_area: Vec<u32>,
     fallback: Bvh,
     lookup: L,
     max_tries: u32,
@@ -135,22 +134,14 @@ impl<L: AreaLookup> Scene<L> {
     ) -> Result<Self, SceneError> {
         let mut arena = BuildArena::with_capacity(tris.len());
         let mut local = Vec::with_capacity(areas.len());
-        let mut triangles_per_area = Vec::with_capacity(areas.len());
         for (i, area) in areas.iter().enumerate() {
             let fail = |error| SceneError::Local {
                 area: i as u32,
                 error,
             };
-            let bounds = area.bounds();
-            let inside = (0..tris.len() as u32).filter(|&t| {
-                let tri = &tris[t as usize];
-                // The box test rejects most triangles cheaply; the SAT test is exact.
-                !tri.bounds().intersection(bounds).is_empty() && area.overlaps_triangle(tri)
-            });
             arena
-                .load_triangle_subset(tris, inside)
+                .load_triangle_subset(tris, Self::triangles_in_area(area, tris))
                 .map_err(|e| fail(e.into()))?;
-            triangles_per_area.push(arena.len() as u32);
             let mut bvh = Bvh::with_capacity(arena.len());
             options
                 .preset
@@ -169,10 +160,42 @@ impl<L: AreaLookup> Scene<L> {
         Ok(Self {
             areas,
             local,
-            triangles_per_area,
             fallback,
             lookup,
             max_tries: options.max_tries,
+        })
+    }
+
+    /// Assembles a scene from parts built elsewhere (a threaded host builds the local BVHs in
+    /// parallel). `None` unless there is one local BVH per area. The caller vouches that each
+    /// local BVH holds every triangle overlapping its area (as [`Scene::build`] selects them):
+    /// the exactness of the queries rests on it.
+    pub fn from_parts(
+        areas: Vec<InfluenceArea>,
+        local: Vec<Bvh>,
+        fallback: Bvh,
+        lookup: L,
+        max_tries: u32,
+    ) -> Option<Self> {
+        (areas.len() == local.len()).then_some(Self {
+            areas,
+            local,
+            fallback,
+            lookup,
+            max_tries,
+        })
+    }
+
+    /// The triangle ids that [`Scene::build`] gives area `area`'s local BVH: those overlapping it,
+    /// by a cheap box test first and the exact separating-axis test then.
+    pub fn triangles_in_area<'a>(
+        area: &'a InfluenceArea,
+        tris: &'a [Triangle],
+    ) -> impl Iterator<Item = u32> + 'a {
+        let bounds = area.bounds();
+        (0..tris.len() as u32).filter(move |&t| {
+            let tri = &tris[t as usize];
+            !tri.bounds().intersection(bounds).is_empty() && area.overlaps_triangle(tri)
         })
     }
 
@@ -187,8 +210,11 @@ impl<L: AreaLookup> Scene<L> {
     }
 
     /// How many triangles each area's local BVH holds.
-    pub fn triangles_per_area(&self) -> &[u32] {
-        &self.triangles_per_area
+    pub fn triangles_per_area(&self) -> Vec<u32> {
+        self.local
+            .iter()
+            .map(|b| b.prim_indices().len() as u32)
+            .collect()
     }
 
     /// The fallback BVH.
@@ -332,7 +358,6 @@ impl<L: AreaLookup> Scene<L> {
         let mask: Vec<bool> = (0..self.areas.len()).map(keep).collect();
         retain_by_mask(&mut self.areas, &mask);
         retain_by_mask(&mut self.local, &mask);
-        retain_by_mask(&mut self.triangles_per_area, &mask);
         self.lookup = self.lookup.rebuilt(&self.areas);
     }
 }

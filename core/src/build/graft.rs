@@ -1,0 +1,168 @@
+//! Grafting separately built subtrees into the top of a build: the assembly step of threaded
+//! builds, which gives exactly the single-threaded tree.
+
+use alloc::vec::Vec;
+
+use super::Subtree;
+use crate::bvh::{Bvh, BvhNode};
+
+/// Why subtrees could not be grafted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GraftError {
+    /// `jobs` and `subtrees` differ in length.
+    CountMismatch,
+    /// A subtree does not cover its job's primitives, or its job is not a leaf of the top.
+    BadSubtree {
+        /// Index of the job.
+        job: usize,
+    },
+}
+
+impl core::fmt::Display for GraftError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            GraftError::CountMismatch => f.write_str("one subtree per job is needed"),
+            GraftError::BadSubtree { job } => write!(f, "subtree {job} does not match its job"),
+        }
+    }
+}
+
+impl Bvh {
+    /// Replaces each job's placeholder leaf in `top` (from [`super::Builder::build_top`]) with the
+    /// subtree built for it (with [`super::Builder::build_subtree_into`] over the job's slots, in
+    /// slot order), then lays the nodes out in the order the single-threaded builder allocates
+    /// them, so the result equals `build_into`'s tree node for node.
+    pub fn graft(top: Bvh, jobs: &[Subtree], subtrees: &[Bvh]) -> Result<Bvh, GraftError> {
+        if jobs.len() != subtrees.len() {
+            return Err(GraftError::CountMismatch);
+        }
+        let mut nodes = top.nodes;
+        let mut prim_indices = top.prim_indices;
+        let mut max_depth = top.max_depth;
+        for (j, (job, sub)) in jobs.iter().zip(subtrees).enumerate() {
+            let bad = GraftError::BadSubtree { job: j };
+            let (start, count) = (job.start as usize, job.count as usize);
+            let placeholder = nodes.get(job.node as usize).ok_or(bad)?;
+            if !placeholder.is_leaf() || sub.prim_indices.len() != count || sub.nodes.is_empty() {
+                return Err(bad);
+            }
+            prim_indices
+                .get_mut(start..start + count)
+                .ok_or(bad)?
+                .copy_from_slice(&sub.prim_indices);
+            max_depth = max_depth.max(sub.max_depth);
+            let offset = nodes.len() as u32;
+            nodes[job.node as usize] = place(&sub.nodes[0], job.start, offset);
+            nodes.extend(sub.nodes[1..].iter().map(|n| place(n, job.start, offset)));
+        }
+        Ok(Bvh {
+            nodes: canonical_order(&nodes),
+            prim_indices,
+            max_depth,
+        })
+    }
+}
+
+/// A subtree node moved into the whole tree: local node `i >= 1` goes to `offset + i - 1`, local
+/// slot `s` to `start + s`.
+#[inline]
+fn place(n: &BvhNode, start: u32, offset: u32) -> BvhNode {
+    BvhNode {
+        left_first: if n.is_leaf() {
+            n.left_first + start
+        } else {
+            n.left_first - 1 + offset
+        },
+        ..*n
+    }
+}
+
+/// The nodes re-laid out as the builder allocates them: root first; splitting a node appends its
+/// two children; the left subtree is finished before the right one is opened.
+fn canonical_order(nodes: &[BvhNode]) -> Vec<BvhNode> {
+    let mut out = Vec::with_capacity(nodes.len());
+    if nodes.is_empty() {
+        return out;
+    }
+    out.push(nodes[0]);
+    // (old index, new index) of nodes whose children are not placed yet.
+    let mut pending: Vec<(u32, u32)> = Vec::new();
+    let mut current = (0u32, 0u32);
+    loop {
+        let node = nodes[current.0 as usize];
+        if !node.is_leaf() {
+            let (l_old, l_new) = (node.left_first, out.len() as u32);
+            out.push(nodes[l_old as usize]);
+            out.push(nodes[l_old as usize + 1]);
+            out[current.1 as usize].left_first = l_new;
+            pending.push((l_old + 1, l_new + 1));
+            current = (l_old, l_new);
+            continue;
+        }
+        match pending.pop() {
+            Some(next) => current = next,
+            None => break,
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use alloc::vec::Vec;
+
+    use glam::Vec3;
+
+    use super::*;
+    use crate::build::{BuildArena, Builder};
+    use crate::geometry::Triangle;
+    use crate::random::Pcg32;
+
+    #[test]
+    fn grafted_tree_equals_single_threaded_tree() {
+        let mut rng = Pcg32::new(8);
+        let mut v = |s: f32| Vec3::new(rng.range(-s, s), rng.range(-s, s), rng.range(-s, s));
+        let tris: Vec<Triangle> = (0..3000)
+            .map(|_| {
+                let a = v(10.0);
+                Triangle::new(a, a + v(0.5), a + v(0.5))
+            })
+            .collect();
+        let builder = Builder::sah();
+        let whole = builder.build(&tris).unwrap();
+        for cutoff in [1, 7, 100, 1000, 5000] {
+            let mut arena = BuildArena::with_capacity(tris.len());
+            arena.load_triangles(&tris).unwrap();
+            let mut top = Bvh::default();
+            let mut jobs = Vec::new();
+            builder
+                .build_top(&mut arena, &mut top, cutoff, &mut jobs)
+                .unwrap();
+            let subtrees: Vec<Bvh> = jobs
+                .iter()
+                .map(|job| {
+                    let mut local = BuildArena::with_capacity(job.count as usize);
+                    for slot in job.start..job.start + job.count {
+                        let (id, b) = arena.prim(slot as usize).unwrap();
+                        local.push(id, b).unwrap();
+                    }
+                    let mut out = Bvh::default();
+                    builder
+                        .build_subtree_into(&mut local, &mut out, job.depth)
+                        .unwrap();
+                    out
+                })
+                .collect();
+            let grafted = Bvh::graft(top, &jobs, &subtrees).unwrap();
+            assert_eq!(grafted, whole, "cutoff {cutoff}");
+        }
+    }
+
+    #[test]
+    fn mismatched_jobs_are_errors() {
+        assert_eq!(
+            Bvh::graft(Bvh::default(), &[], &[Bvh::default()]),
+            Err(GraftError::CountMismatch)
+        );
+    }
+}

@@ -8,4 +8,5 @@
 #![forbid(unsafe_code)]
 
 pub mod cli;
+pub mod parallel;
 pub mod scene;

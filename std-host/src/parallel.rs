@@ -1,0 +1,190 @@
+//! Threaded builds with rayon: the same trees as the single-threaded core builder, sooner.
+//!
+//! A binary build is split where subtrees get small: the core builds the top of the tree on one
+//! thread and hands back the nodes of at most `cutoff` primitives as jobs
+//! ([`Builder::build_top`]); rayon builds the jobs on all threads, each over its own arena at its
+//! own depth ([`Builder::build_subtree_into`]); [`Bvh::graft`] splices them in and re-lays the
+//! nodes out in the single-threaded order. The result is the single-threaded tree node for node,
+//! which the tests check. Scenes build their local BVHs and the fallback BVH concurrently.
+
+use rayon::prelude::*;
+
+use rdbvh_core::build::{BuildArena, Builder, Preset, PresetError, Subtree};
+use rdbvh_core::bvh::Bvh;
+use rdbvh_core::geometry::Triangle;
+use rdbvh_core::heuristics::{AxisChooser, CostModel, Termination};
+use rdbvh_core::influence::InfluenceArea;
+use rdbvh_core::toplevel::{AreaLookup, Scene, SceneError, SceneOptions};
+use rdbvh_core::BuildError;
+
+/// Jobs per thread: enough that uneven subtrees still balance across threads.
+const JOBS_PER_THREAD: usize = 16;
+
+/// The smallest subtree worth a job of its own: below this, scheduling costs more than it saves.
+const MIN_JOB: u32 = 2048;
+
+/// The cutoff for `n` primitives on the current rayon pool.
+fn cutoff(n: usize) -> u32 {
+    let jobs = rayon::current_num_threads().max(1) * JOBS_PER_THREAD;
+    ((n / jobs) as u32).max(MIN_JOB)
+}
+
+/// Builds over `tris` with every rayon thread. Equal to `builder.build(tris)`.
+pub fn build<A, C, T>(builder: &Builder<A, C, T>, tris: &[Triangle]) -> Result<Bvh, BuildError>
+where
+    A: AxisChooser + Sync,
+    C: CostModel + Sync,
+    T: Termination + Sync,
+{
+    let mut arena = BuildArena::with_capacity(tris.len());
+    arena.load_triangles(tris)?;
+    build_arena(builder, &mut arena)
+}
+
+/// Builds over the primitives loaded in `arena` with every rayon thread. Equal to
+/// `builder.build_into(arena, ..)`.
+pub fn build_arena<A, C, T>(
+    builder: &Builder<A, C, T>,
+    arena: &mut BuildArena,
+) -> Result<Bvh, BuildError>
+where
+    A: AxisChooser + Sync,
+    C: CostModel + Sync,
+    T: Termination + Sync,
+{
+    let mut top = Bvh::with_capacity(arena.len());
+    let mut jobs = Vec::new();
+    builder.build_top(arena, &mut top, cutoff(arena.len()), &mut jobs)?;
+    let arena = &*arena;
+    let subtrees = jobs
+        .par_iter()
+        .map(|job| build_job(builder, arena, job))
+        .collect::<Result<Vec<Bvh>, BuildError>>()?;
+    Bvh::graft(top, &jobs, &subtrees).map_err(|_| BuildError::InvalidConfig("graft mismatch"))
+}
+
+fn build_job<A, C, T>(
+    builder: &Builder<A, C, T>,
+    arena: &BuildArena,
+    job: &Subtree,
+) -> Result<Bvh, BuildError>
+where
+    A: AxisChooser,
+    C: CostModel,
+    T: Termination,
+{
+    let mut local = BuildArena::with_capacity(job.count as usize);
+    for slot in job.start..job.start + job.count {
+        if let Some((id, bounds)) = arena.prim(slot as usize) {
+            local.push(id, bounds)?;
+        }
+    }
+    let mut out = Bvh::with_capacity(job.count as usize);
+    builder.build_subtree_into(&mut local, &mut out, job.depth)?;
+    Ok(out)
+}
+
+/// Builds a [`Scene`] with its local BVHs and its fallback BVH on all threads; equal to
+/// [`Scene::build`]'s scene.
+pub fn build_scene<L: AreaLookup>(
+    tris: &[Triangle],
+    areas: Vec<InfluenceArea>,
+    options: &SceneOptions,
+    lookup: impl FnOnce(&[InfluenceArea]) -> L,
+) -> Result<Scene<L>, SceneError> {
+    let local_build = |(i, area): (usize, &InfluenceArea)| {
+        let fail = |error: PresetError| SceneError::Local {
+            area: i as u32,
+            error,
+        };
+        let ids: Vec<u32> = Scene::<L>::triangles_in_area(area, tris).collect();
+        let mut arena = BuildArena::with_capacity(ids.len());
+        arena
+            .load_triangle_subset(tris, ids)
+            .map_err(|e| fail(e.into()))?;
+        let mut bvh = Bvh::with_capacity(arena.len());
+        options
+            .preset
+            .build_into(Some(area), &options.local, &mut arena, &mut bvh)
+            .map_err(fail)?;
+        Ok(bvh)
+    };
+    let fallback_build = || {
+        let mut arena = BuildArena::with_capacity(tris.len());
+        arena
+            .load_triangles(tris)
+            .map_err(|e| SceneError::Fallback(e.into()))?;
+        let mut bvh = Bvh::with_capacity(tris.len());
+        Preset::Sah
+            .build_into(None, &options.fallback, &mut arena, &mut bvh)
+            .map_err(SceneError::Fallback)?;
+        Ok::<_, SceneError>(bvh)
+    };
+    let (local, fallback) = rayon::join(
+        || {
+            areas
+                .par_iter()
+                .enumerate()
+                .map(local_build)
+                .collect::<Result<Vec<Bvh>, SceneError>>()
+        },
+        fallback_build,
+    );
+    let lookup = lookup(&areas);
+    Ok(
+        Scene::from_parts(areas, local?, fallback?, lookup, options.max_tries)
+            .expect("one local BVH per area by construction"),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rdbvh_core::influence::{PlaneArea, PointArea};
+    use rdbvh_core::random::Pcg32;
+    use rdbvh_core::toplevel::Octree;
+    use rdbvh_core::Vec3;
+
+    fn soup(n: usize) -> Vec<Triangle> {
+        let mut rng = Pcg32::new(3);
+        let mut v = |s: f32| Vec3::new(rng.range(-s, s), rng.range(-s, s), rng.range(-s, s));
+        (0..n)
+            .map(|_| {
+                let a = v(10.0);
+                Triangle::new(a, a + v(0.4), a + v(0.4))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn threaded_build_equals_single_threaded() {
+        let tris = soup(40_000);
+        for builder in [Builder::sah()] {
+            assert_eq!(
+                build(&builder, &tris).unwrap(),
+                builder.build(&tris).unwrap()
+            );
+        }
+        let lsph = Builder::lsph();
+        assert_eq!(build(&lsph, &tris).unwrap(), lsph.build(&tris).unwrap());
+        assert_eq!(build(&lsph, &[]).unwrap(), lsph.build(&[]).unwrap());
+    }
+
+    #[test]
+    fn threaded_scene_equals_single_threaded() {
+        let tris = soup(5_000);
+        let areas: Vec<InfluenceArea> = vec![
+            PlaneArea::new(Vec3::new(0.0, 0.0, -12.0), Vec3::Z, 6.0, 6.0, 20.0)
+                .unwrap()
+                .into(),
+            PointArea::new(Vec3::new(0.0, 12.0, 0.0), -Vec3::Y, 60.0, 60.0, 1.0, 20.0)
+                .unwrap()
+                .into(),
+        ];
+        let options = SceneOptions::default();
+        let a = build_scene(&tris, areas.clone(), &options, |a| Octree::build(a, 5)).unwrap();
+        let b = Scene::with_octree(&tris, areas, &options, 5).unwrap();
+        assert_eq!(a.local_bvhs(), b.local_bvhs());
+        assert_eq!(a.fallback(), b.fallback());
+    }
+}

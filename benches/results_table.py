@@ -3,27 +3,31 @@
 RESULTS.md: throughput per library (median of the samples, robust to the odd slow sample on a
 shared machine) and its ratio to rdbvh.
 
-Usage: python3 benches/results_table.py [CRITERION_DIR]   (default: $CARGO_TARGET_DIR/criterion,
-else target/criterion)
+Usage: python3 benches/results_table.py [CRITERION_DIR...]   (default: $CARGO_TARGET_DIR/criterion,
+else target/criterion). With several directories (copies of criterion/ from several runs), each
+cell is the median over the runs: on a shared machine one run can be slowed as a whole.
 """
 import json
 import os
+import statistics
 import sys
 from pathlib import Path
 
-LIBS = ["rdbvh", "rdbvh-reuse", "obvhs-bvh2", "obvhs-cwbvh", "bvh", "parry3d"]
+LIBS = ["rdbvh", "rdbvh-reuse", "rdbvh-wide", "obvhs-bvh2", "obvhs-cwbvh", "bvh", "parry3d"]
 
 
-def load(root):
-    """{(group, function): M elements per second}"""
-    out = {}
-    for bench in Path(root).glob("**/new/benchmark.json"):
-        meta = json.loads(bench.read_text())
-        est = json.loads((bench.parent / "estimates.json").read_text())
-        elements = meta["throughput"]["Elements"]
-        ns = est["median"]["point_estimate"]
-        out[(meta["group_id"], meta["function_id"])] = elements * 1e3 / ns
-    return out
+def load(roots):
+    """{(group, function): M elements per second}, the median over the runs in `roots`"""
+    runs = {}
+    for root in roots:
+        for bench in Path(root).glob("**/new/benchmark.json"):
+            meta = json.loads(bench.read_text())
+            est = json.loads((bench.parent / "estimates.json").read_text())
+            elements = meta["throughput"]["Elements"]
+            ns = est["median"]["point_estimate"]
+            key = (meta["group_id"], meta["function_id"])
+            runs.setdefault(key, []).append(elements * 1e3 / ns)
+    return {key: statistics.median(values) for key, values in runs.items()}
 
 
 def cell(data, group, lib):
@@ -50,8 +54,8 @@ def table(data, columns):
 
 def main():
     target = os.environ.get("CARGO_TARGET_DIR", "target")
-    root = sys.argv[1] if len(sys.argv) > 1 else os.path.join(target, "criterion")
-    data = load(root)
+    roots = sys.argv[1:] or [os.path.join(target, "criterion")]
+    data = load(roots)
     for scene, label in [("bunny", "bunny"), ("sponza_crytek", "Sponza")]:
         print(f"\nTraversal on the {label}:\n")
         print(

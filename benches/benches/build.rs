@@ -12,7 +12,7 @@ use std::time::Duration;
 
 use clock::Clock;
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
-use rdbvh_benches::peers::{BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Rdbvh};
+use rdbvh_benches::peers::{BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Rdbvh, RdbvhWide};
 use rdbvh_benches::{load_scene, RdbvhReuse, BENCH_SCENES};
 use rdbvh_core::geometry::Triangle;
 
@@ -47,6 +47,7 @@ fn builds(c: &mut Criterion<Clock>) {
         group.bench_function("rdbvh-reuse", |b| {
             b.iter(|| reuse.build(black_box(&tris)).nodes().len())
         });
+        bench_library::<RdbvhWide>(&mut group, &tris);
         bench_library::<ObvhsBvh2>(&mut group, &tris);
         bench_library::<ObvhsCwbvh>(&mut group, &tris);
         bench_library::<BvhCrate>(&mut group, &tris);

@@ -14,7 +14,9 @@ use clock::Clock;
 use criterion::{
     criterion_group, criterion_main, BenchmarkGroup, Criterion, SamplingMode, Throughput,
 };
-use rdbvh_benches::peers::{BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Prepared, Rdbvh};
+use rdbvh_benches::peers::{
+    BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Prepared, Rdbvh, RdbvhWide,
+};
 use rdbvh_benches::{
     agreement, bounds, load_scene, ray_set, Answers, RayKind, BENCH_SCENES, MIN_AGREEMENT,
 };
@@ -85,6 +87,7 @@ fn traversals(c: &mut Criterion<Clock>) {
             })
             .collect();
         let rdbvh = Subject::<Rdbvh>::new(name, &tris, &sets);
+        let wide = Subject::<RdbvhWide>::new(name, &tris, &sets);
         let obvhs2 = Subject::<ObvhsBvh2>::new(name, &tris, &sets);
         let obvhs8 = Subject::<ObvhsCwbvh>::new(name, &tris, &sets);
         let bvh = Subject::<BvhCrate>::new(name, &tris, &sets);
@@ -100,6 +103,7 @@ fn traversals(c: &mut Criterion<Clock>) {
                     .warm_up_time(Duration::from_millis(500))
                     .measurement_time(Duration::from_secs(2));
                 rdbvh.bench(&mut group, *kind, any);
+                wide.bench(&mut group, *kind, any);
                 obvhs2.bench(&mut group, *kind, any);
                 obvhs8.bench(&mut group, *kind, any);
                 bvh.bench(&mut group, *kind, any);

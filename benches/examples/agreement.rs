@@ -6,7 +6,9 @@
 
 use std::time::Instant;
 
-use rdbvh_benches::peers::{BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Prepared, Rdbvh};
+use rdbvh_benches::peers::{
+    BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Prepared, Rdbvh, RdbvhWide,
+};
 use rdbvh_benches::{agreement, bounds, load_scene, ray_set, Answers, RayKind, BENCH_SCENES};
 use rdbvh_core::geometry::{Ray, Triangle};
 
@@ -56,6 +58,7 @@ fn main() {
             let rays = ray_set(&b, kind);
             let reference = Prepared::<Rdbvh>::new(&tris).answers(&rays);
             report::<Rdbvh>(&tris, &rays, &reference, kind);
+            report::<RdbvhWide>(&tris, &rays, &reference, kind);
             report::<ObvhsBvh2>(&tris, &rays, &reference, kind);
             report::<ObvhsCwbvh>(&tris, &rays, &reference, kind);
             report::<BvhCrate>(&tris, &rays, &reference, kind);

@@ -7,6 +7,7 @@
 #![deny(missing_docs)]
 #![forbid(unsafe_code)]
 
+pub mod areas;
 pub mod cli;
 pub mod parallel;
 pub mod scene;

@@ -1,5 +1,6 @@
 //! End-to-end tests of the `rdbvh` binary: the output contracts scripts rely on, one-line errors,
-//! and `trace` answers checked against the brute-force oracle on built-in and real scenes.
+//! and `trace` answers (with one BVH, and through the scene structure of influence areas) checked
+//! against the brute-force oracle on built-in and real scenes.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -7,6 +8,7 @@ use std::process::{Command, Output};
 use rdbvh::scene::{Mt19937, Scene};
 use rdbvh_core::brute_force;
 use rdbvh_core::geometry::Ray;
+use rdbvh_core::influence::{InfluenceArea, PointDistribution, RaySampler};
 use rdbvh_core::Vec3;
 
 fn rdbvh(args: &[&str]) -> Output {
@@ -191,23 +193,18 @@ fn random_rays(scene: &Scene, n: usize, seed: u32) -> Vec<[f32; 8]> {
         .collect()
 }
 
-/// Runs `trace` on `scene_arg` both ways and compares every answer with brute force, exactly.
-fn check_trace(scene_arg: &str, rays_count: usize) {
-    let scene = Scene::open(scene_arg).unwrap();
-    let rays = random_rays(&scene, rays_count, 7);
-    let dir = scratch(&scene.name.replace(['/', ':'], "_"));
-    let rays_csv = dir.join("rays.csv");
-    // Columns out of the documented order, to check they are found by name.
+/// Writes `rays` (`[ox, oy, oz, dx, dy, dz, tmin, tmax]`) as CSV, columns out of the documented
+/// order to check they are found by name, and returns the rays as the CLI reads them.
+fn write_rays(path: &Path, rays: &[[f32; 8]]) -> Vec<Ray> {
     let mut csv = String::from("tmax,dx,dy,dz,ox,oy,oz,tmin\n");
-    for r in &rays {
+    for r in rays {
         csv += &format!(
             "{},{},{},{},{},{},{},{}\n",
             r[7], r[3], r[4], r[5], r[0], r[1], r[2], r[6]
         );
     }
-    std::fs::write(&rays_csv, csv).unwrap();
-    let rays: Vec<Ray> = rays
-        .iter()
+    std::fs::write(path, csv).unwrap();
+    rays.iter()
         .map(|r| {
             Ray::segment(
                 Vec3::new(r[0], r[1], r[2]),
@@ -217,7 +214,68 @@ fn check_trace(scene_arg: &str, rays_count: usize) {
             )
             .unwrap()
         })
-        .collect();
+        .collect()
+}
+
+/// Checks the answers file `hits_csv` against brute force for every ray, exactly; returns how
+/// many rays hit.
+fn assert_answers(
+    hits_csv: &Path,
+    rays: &[Ray],
+    scene: &Scene,
+    any_hit: bool,
+    label: &str,
+) -> usize {
+    let answers = std::fs::read_to_string(hits_csv).unwrap();
+    let mut lines = answers.lines();
+    let header = lines.next().unwrap();
+    assert_eq!(
+        header,
+        if any_hit {
+            "ray,hit"
+        } else {
+            "ray,t,triangle,u,v"
+        }
+    );
+    let mut count = 0;
+    let mut hits = 0;
+    for (i, (line, ray)) in lines.zip(rays).enumerate() {
+        let f: Vec<&str> = line.split(',').collect();
+        assert_eq!(f[0], i.to_string(), "rays stay in input order");
+        if any_hit {
+            let expected = brute_force::any_hit(ray, &scene.triangles);
+            assert_eq!(f[1], if expected { "1" } else { "0" }, "{label} ray {i}");
+            hits += usize::from(expected);
+        } else {
+            match brute_force::closest_hit(ray, &scene.triangles) {
+                None => assert_eq!(&f[1..], ["", "", "", ""], "{label} ray {i}"),
+                Some(h) => {
+                    let t: f32 = f[1].parse().unwrap();
+                    let tri: u32 = f[2].parse().unwrap();
+                    let u: f32 = f[3].parse().unwrap();
+                    let v: f32 = f[4].parse().unwrap();
+                    assert_eq!(
+                        (t, tri, u, v),
+                        (h.t, h.triangle, h.u, h.v),
+                        "{label} ray {i}"
+                    );
+                    hits += 1;
+                }
+            }
+        }
+        count += 1;
+    }
+    assert_eq!(count, rays.len(), "{label}");
+    hits
+}
+
+/// Runs `trace` on `scene_arg` both ways and compares every answer with brute force, exactly.
+fn check_trace(scene_arg: &str, rays_count: usize) {
+    let scene = Scene::open(scene_arg).unwrap();
+    let rays = random_rays(&scene, rays_count, 7);
+    let dir = scratch(&scene.name.replace(['/', ':'], "_"));
+    let rays_csv = dir.join("rays.csv");
+    let rays = write_rays(&rays_csv, &rays);
 
     for any_hit in [false, true] {
         let hits_csv = dir.join(if any_hit { "any.csv" } else { "closest.csv" });
@@ -239,53 +297,11 @@ fn check_trace(scene_arg: &str, rays_count: usize) {
             "{}",
             text(&out.stderr)
         );
-        let answers = std::fs::read_to_string(&hits_csv).unwrap();
-        let mut lines = answers.lines();
-        let header = lines.next().unwrap();
-        assert_eq!(
-            header,
-            if any_hit {
-                "ray,hit"
-            } else {
-                "ray,t,triangle,u,v"
-            }
-        );
-        let mut count = 0;
-        let mut hits = 0;
-        for (i, (line, ray)) in lines.zip(&rays).enumerate() {
-            let f: Vec<&str> = line.split(',').collect();
-            assert_eq!(f[0], i.to_string(), "rays stay in input order");
-            if any_hit {
-                let expected = brute_force::any_hit(ray, &scene.triangles);
-                assert_eq!(
-                    f[1],
-                    if expected { "1" } else { "0" },
-                    "{scene_arg} ray {i}"
-                );
-                hits += usize::from(expected);
-            } else {
-                match brute_force::closest_hit(ray, &scene.triangles) {
-                    None => assert_eq!(&f[1..], ["", "", "", ""], "{scene_arg} ray {i}"),
-                    Some(h) => {
-                        let t: f32 = f[1].parse().unwrap();
-                        let tri: u32 = f[2].parse().unwrap();
-                        let u: f32 = f[3].parse().unwrap();
-                        let v: f32 = f[4].parse().unwrap();
-                        assert_eq!(
-                            (t, tri, u, v),
-                            (h.t, h.triangle, h.u, h.v),
-                            "{scene_arg} ray {i}"
-                        );
-                        hits += 1;
-                    }
-                }
-            }
-            count += 1;
-        }
-        assert_eq!(count, rays.len());
+        let hits = assert_answers(&hits_csv, &rays, &scene, any_hit, scene_arg);
         assert!(
-            hits > 0 && hits < count,
-            "{scene_arg}: {hits} of {count} rays hit"
+            hits > 0 && hits < rays.len(),
+            "{scene_arg}: {hits} of {} rays hit",
+            rays.len()
         );
     }
     std::fs::remove_dir_all(&dir).ok();
@@ -342,4 +358,595 @@ fn real_scenes_build_and_load_their_lights() {
         "{}",
         text(&out.stderr)
     );
+}
+
+/// Two influence areas in the built-in room: the light's parallel rays (an `experiments.toml`
+/// entry pasted with its experiment keys) and a tilted spot light's radial rays.
+const ROOM_AREAS: &str = r#"
+[[area]]
+scene = "Room"
+kind = "plane"
+orientation = "parallel"
+center = [5.0, 9.9, 5.0]
+normal = [0, -1, 0]
+half_width = 1.0
+half_height = 1.0
+depth = 9.9
+thesis_test = "Room_Plane"
+
+[[area]]
+kind = "point"
+eye = [5.0, 9.5, 5.0]
+direction = [0.2, -1.0, 0.1]
+fov_x_deg = 90.0
+fov_y_deg = 60.0
+near = 0.1
+far = 9.4
+"#;
+
+fn json_of(out: &Output) -> serde_json::Value {
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert_eq!(stdout.lines().count(), 1, "one JSON object: {stdout}");
+    serde_json::from_str(&stdout).unwrap()
+}
+
+/// A failure with exit status `code` and exactly one `error: ` line containing every needle.
+fn assert_one_line_error(out: &Output, code: i32, needles: &[&str], args: &[&str]) {
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{args:?}: {stderr}");
+    assert!(stderr.starts_with("error: "), "{args:?}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    for needle in needles {
+        assert!(
+            stderr.contains(needle),
+            "{args:?}: {needle} not in {stderr}"
+        );
+    }
+}
+
+#[test]
+fn build_with_areas_reports_the_area_build() {
+    let dir = scratch("build-areas");
+    let areas = dir.join("room.toml");
+    std::fs::write(&areas, ROOM_AREAS).unwrap();
+    let areas = areas.to_str().unwrap();
+    let room = Scene::open("builtin:room").unwrap();
+    let first = rdbvh::areas::read_areas(Path::new(areas)).unwrap().entries[0].area;
+    let inside = room
+        .triangles
+        .iter()
+        .filter(|t| first.overlaps_triangle(t))
+        .count();
+    assert!(inside > 0 && inside < room.len());
+
+    let full = json_of(&rdbvh(&[
+        "build",
+        "builtin:room",
+        "--preset",
+        "full",
+        "--areas",
+        areas,
+        "--json",
+    ]));
+    for key in [
+        "triangles",
+        "scene_triangles",
+        "nodes",
+        "leaves",
+        "max_depth",
+        "sah_cost",
+        "pah_cost",
+        "bytes",
+        "load_ms",
+        "select_ms",
+        "build_ms",
+        "mtris_per_s",
+        "builder",
+        "preset",
+        "thesis_mode",
+        "area_kind",
+        "bins",
+        "max_leaf",
+    ] {
+        assert!(full.get(key).is_some(), "missing {key}: {full}");
+    }
+    assert_eq!(full["triangles"], inside, "{full}");
+    assert_eq!(full["scene_triangles"], room.len());
+    assert_eq!(full["preset"], "full");
+    assert_eq!(full["builder"], "spfh");
+    assert_eq!(full["area_kind"], "plane");
+    assert_eq!(full["thesis_mode"], false);
+    assert_eq!(
+        (full["bins"].as_u64(), full["max_leaf"].as_u64()),
+        (Some(16), Some(8))
+    );
+    let pah = full["pah_cost"].as_f64().unwrap();
+    assert!(pah > 0.0 && pah.is_finite(), "{full}");
+
+    // Every preset and the plain builders build the same subset.
+    for (flag, name) in [
+        ("--preset", "sah"),
+        ("--preset", "standard"),
+        ("--preset", "facing"),
+        ("--preset", "longest"),
+        ("--builder", "lsph"),
+    ] {
+        let j = json_of(&rdbvh(&[
+            "build",
+            "builtin:room",
+            flag,
+            name,
+            "--areas",
+            areas,
+            "--json",
+        ]));
+        assert_eq!(j["triangles"], inside, "{name}: {j}");
+        assert!(j["pah_cost"].as_f64().unwrap() > 0.0, "{name}: {j}");
+        if flag == "--builder" {
+            assert_eq!(j["preset"], serde_json::Value::Null);
+            assert_eq!(j["builder"], "lsph");
+        } else {
+            assert_eq!(j["preset"], name);
+        }
+    }
+
+    // Thesis mode: the thesis's bins and leaf size, each still overridable.
+    let thesis = json_of(&rdbvh(&[
+        "build",
+        "builtin:room",
+        "--preset",
+        "full",
+        "--areas",
+        areas,
+        "--thesis-mode",
+        "--json",
+    ]));
+    assert_eq!(thesis["thesis_mode"], true);
+    assert_eq!(
+        (thesis["bins"].as_u64(), thesis["max_leaf"].as_u64()),
+        (Some(41), Some(2))
+    );
+    let overridden = json_of(&rdbvh(&[
+        "build",
+        "builtin:room",
+        "--preset",
+        "longest",
+        "--areas",
+        areas,
+        "--thesis-mode",
+        "--max-leaf",
+        "4",
+        "--bins",
+        "9",
+        "--json",
+    ]));
+    assert_eq!(
+        (overridden["bins"].as_u64(), overridden["max_leaf"].as_u64()),
+        (Some(9), Some(4))
+    );
+
+    // The table names the preset and shows the PAH cost.
+    let table = rdbvh(&[
+        "build",
+        "builtin:room",
+        "--preset",
+        "full",
+        "--areas",
+        areas,
+    ]);
+    assert!(table.status.success(), "{}", text(&table.stderr));
+    let t = text(&table.stdout);
+    for label in ["preset full", "PAH cost", "plane area", "select time"] {
+        assert!(t.contains(label), "{label} missing: {t}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn presets_without_areas() {
+    for preset in ["sah", "standard"] {
+        let j = json_of(&rdbvh(&[
+            "build",
+            "builtin:room",
+            "--preset",
+            preset,
+            "--json",
+        ]));
+        assert_eq!(j["triangles"], j["scene_triangles"]);
+        assert_eq!(j["preset"], preset);
+        assert_eq!(j["pah_cost"], serde_json::Value::Null);
+        assert_eq!(j["area_kind"], serde_json::Value::Null);
+    }
+    let dir = scratch("presets-no-areas");
+    let rays = dir.join("rays.csv");
+    std::fs::write(&rays, "ox,oy,oz,dx,dy,dz\n5,5,5,0,1,0\n").unwrap();
+    let hits = dir.join("hits.csv");
+    let (rays, hits) = (rays.to_str().unwrap(), hits.to_str().unwrap());
+    for preset in ["facing", "longest", "full"] {
+        let args = ["build", "builtin:room", "--preset", preset];
+        assert_one_line_error(&rdbvh(&args), 2, &[preset, "--areas"], &args);
+        let args = [
+            "trace",
+            "builtin:room",
+            "--preset",
+            preset,
+            "--rays",
+            rays,
+            "--out",
+            hits,
+        ];
+        assert_one_line_error(&rdbvh(&args), 2, &[preset, "--areas"], &args);
+    }
+    // A plain trace with a preset that needs no area works as before.
+    let out = rdbvh(&[
+        "trace",
+        "builtin:room",
+        "--preset",
+        "standard",
+        "--rays",
+        rays,
+        "--out",
+        hits,
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(std::fs::read_to_string(hits)
+        .unwrap()
+        .starts_with("ray,t,triangle,u,v\n0,"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn area_and_option_errors_are_one_line() {
+    let dir = scratch("area-errors");
+    let write = |name: &str, body: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, body).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let good = write("good.toml", ROOM_AREAS);
+    let missing = write("missing.toml", &ROOM_AREAS.replace("far = 9.4\n", ""));
+    let kind = write("kind.toml", &ROOM_AREAS.replace("\"point\"", "\"spot\""));
+    let value = write(
+        "value.toml",
+        &ROOM_AREAS.replace("depth = 9.9", "depth = 0"),
+    );
+    let typed = write(
+        "type.toml",
+        &ROOM_AREAS.replace("fov_y_deg = 60.0", "fov_y_deg = \"60\""),
+    );
+    let configs = write(
+        "configs.toml",
+        &ROOM_AREAS.replace("[[area]]", "[[config]]\nfile = \"WoodScene.obj\""),
+    );
+    let rays = write("rays.csv", "ox,oy,oz,dx,dy,dz\n5,5,5,0,1,0\n");
+    let hits = dir.join("hits.csv");
+    let hits = hits.to_str().unwrap();
+    let build = |areas: &str| -> Vec<String> {
+        [
+            "build",
+            "builtin:room",
+            "--preset",
+            "full",
+            "--areas",
+            areas,
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let trace = |areas: &str| -> Vec<String> {
+        [
+            "trace",
+            "builtin:room",
+            "--areas",
+            areas,
+            "--rays",
+            &rays,
+            "--out",
+            hits,
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let cases: Vec<(Vec<String>, i32, Vec<&str>)> = vec![
+        (
+            build(&missing),
+            1,
+            vec!["missing.toml line 13: area 1: missing key `far`"],
+        ),
+        (trace(&missing), 1, vec!["area 1: missing key `far`"]),
+        (
+            build(&kind),
+            1,
+            vec!["kind.toml line 14: area 1: unknown kind \"spot\""],
+        ),
+        (
+            build(&value),
+            1,
+            vec!["value.toml line 10: area 0: `depth` must be positive"],
+        ),
+        (
+            build(&typed),
+            1,
+            vec!["area 1: `fov_y_deg` must be a number, not the string"],
+        ),
+        (
+            build(&configs),
+            1,
+            vec![
+                "no [[config]] entry is for scene builtin:room",
+                "WoodScene.obj",
+            ],
+        ),
+        (
+            build("/nonexistent/areas.toml"),
+            1,
+            vec!["/nonexistent/areas.toml: cannot read"],
+        ),
+        (
+            trace("/nonexistent/areas.toml"),
+            1,
+            vec!["/nonexistent/areas.toml"],
+        ),
+        (
+            [
+                "build",
+                "builtin:room",
+                "--preset",
+                "full",
+                "--builder",
+                "lsph",
+                "--areas",
+                &good,
+            ]
+            .map(String::from)
+            .to_vec(),
+            2,
+            vec!["--builder", "--preset"],
+        ),
+        (
+            ["build", "builtin:room", "--thesis-mode"]
+                .map(String::from)
+                .to_vec(),
+            2,
+            vec!["--preset"],
+        ),
+        (
+            ["build", "builtin:room", "--preset", "pah"]
+                .map(String::from)
+                .to_vec(),
+            2,
+            vec!["--preset", "full"],
+        ),
+        (
+            {
+                let mut a = trace(&good);
+                a.extend(["--builder".into(), "lsph".into()]);
+                a
+            },
+            2,
+            vec!["--builder", "--preset"],
+        ),
+        (
+            {
+                let mut a = trace(&good);
+                a.extend(["--octree-levels".into(), "0".into()]);
+                a
+            },
+            2,
+            vec!["--octree-levels"],
+        ),
+        (
+            {
+                let mut a = trace(&good);
+                a.extend(["--max-tries".into(), "0".into()]);
+                a
+            },
+            2,
+            vec!["--max-tries"],
+        ),
+        (
+            [
+                "trace",
+                "builtin:room",
+                "--lookup",
+                "list",
+                "--rays",
+                &rays,
+                "--out",
+                hits,
+            ]
+            .map(String::from)
+            .to_vec(),
+            2,
+            vec!["--areas"],
+        ),
+    ];
+    for (args, code, needles) in cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        assert_one_line_error(&rdbvh(&args), code, &needles, &args);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Rays for a scene with areas: per area, rays sampled from it (affine), the same jittered a few
+/// degrees (mostly just outside the affinity tolerance), and unrelated random rays.
+fn area_rays(scene: &Scene, areas: &[InfluenceArea], per_area: usize, seed: u32) -> Vec<[f32; 8]> {
+    let mut rays = Vec::new();
+    for (i, area) in areas.iter().enumerate() {
+        let seed = u64::from(seed) * 100 + i as u64;
+        let affine = RaySampler::new(*area, seed).distribution(PointDistribution::SolidAngle);
+        let jittered = RaySampler::new(*area, seed + 50).jitter_deg(3.0);
+        for r in affine.take(per_area).chain(jittered.take(per_area / 3)) {
+            rays.push([
+                r.origin.x, r.origin.y, r.origin.z, r.dir.x, r.dir.y, r.dir.z, r.t_min, r.t_max,
+            ]);
+        }
+    }
+    rays.extend(random_rays(scene, per_area, seed));
+    rays
+}
+
+/// The local hit rate (percent) from `trace --areas`'s summary, checking the summary's lines.
+fn local_hit_rate(stderr: &str) -> f64 {
+    for needle in [
+        "rays/s",
+        "local hit rate",
+        "with the structure",
+        "with the fallback BVH alone",
+        "structure: `",
+    ] {
+        assert!(stderr.contains(needle), "{needle} missing: {stderr}");
+    }
+    let rest = stderr.split("local hit rate ").nth(1).unwrap();
+    rest.split('%').next().unwrap().parse().unwrap()
+}
+
+/// Runs `trace --areas AREAS` on `scene_arg` with `extra` options, closest and any hit, and checks
+/// every answer against brute force; returns the closest-hit local hit rate.
+fn check_structure_trace(
+    scene_arg: &str,
+    areas_file: &Path,
+    rays: &[[f32; 8]],
+    extra: &[&str],
+    dir: &Path,
+) -> f64 {
+    let scene = Scene::open(scene_arg).unwrap();
+    let rays_csv = dir.join("rays.csv");
+    let rays = write_rays(&rays_csv, rays);
+    let mut rate = 0.0;
+    for any_hit in [false, true] {
+        let hits_csv = dir.join("hits.csv");
+        let mut args = vec![
+            "trace",
+            scene_arg,
+            "--areas",
+            areas_file.to_str().unwrap(),
+            "--rays",
+            rays_csv.to_str().unwrap(),
+            "--out",
+            hits_csv.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        if any_hit {
+            args.push("--any-hit");
+        }
+        let out = rdbvh(&args);
+        let stderr = text(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {stderr}");
+        let r = local_hit_rate(&stderr);
+        if !any_hit {
+            rate = r;
+        }
+        let label = format!("{scene_arg} {extra:?}");
+        let hits = assert_answers(&hits_csv, &rays, &scene, any_hit, &label);
+        assert!(hits > 0, "{label}: no hits");
+    }
+    rate
+}
+
+#[test]
+fn trace_through_the_structure_agrees_with_brute_force() {
+    let dir = scratch("structure");
+    let areas_file = dir.join("room.toml");
+    std::fs::write(&areas_file, ROOM_AREAS).unwrap();
+    let scene = Scene::open("builtin:room").unwrap();
+    let areas = rdbvh::areas::read_areas(&areas_file).unwrap().areas();
+    let rays = area_rays(&scene, &areas, 600, 3);
+    for extra in [
+        &[][..],
+        &["--lookup", "list"],
+        &[
+            "--preset",
+            "standard",
+            "--max-tries",
+            "2",
+            "--octree-levels",
+            "3",
+        ],
+        &["--preset", "longest", "--thesis-mode"],
+        &["--thesis-mode", "--octree-levels", "7"],
+        &["--preset", "facing", "--lookup", "list", "--max-tries", "2"],
+    ] {
+        let rate = check_structure_trace("builtin:room", &areas_file, &rays, extra, &dir);
+        // Most of the sampled rays are affine and hit inside their area.
+        assert!(rate > 25.0, "{extra:?}: local hit rate {rate}%");
+    }
+    // Unrelated rays only: nothing is answered locally, and the answers are still exact.
+    let random = random_rays(&scene, 500, 9);
+    let rate = check_structure_trace("builtin:room", &areas_file, &random, &[], &dir);
+    assert!(rate < 1.0, "random rays: local hit rate {rate}%");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The thesis scenes with their own areas, read straight from `experiments.toml`: the file's
+/// `[[config]]` entries for each scene become the structure's areas.
+#[test]
+fn trace_through_the_structure_on_thesis_scenes() {
+    let Some(scenes) = shared_scenes("trace_through_the_structure_on_thesis_scenes") else {
+        return;
+    };
+    let experiments = scenes.join("../thesis/experiments.toml");
+    let file = rdbvh::areas::read_areas(&experiments).unwrap();
+    let dir = scratch("thesis-structure");
+    let mut local = 0.0;
+    for name in [
+        "Random100.obj",
+        "Random1000.obj",
+        "MonkeyModel.obj",
+        "Cottage.obj",
+        "CottageWalls.obj",
+        "WoodScene.obj",
+    ] {
+        let path = scenes.join("thesis").join(name);
+        let scene = Scene::load(&path).unwrap();
+        let areas: Vec<InfluenceArea> = file
+            .for_scene(&scene.name)
+            .unwrap()
+            .iter()
+            .map(|e| e.area)
+            .collect();
+        assert_eq!(areas.len(), 8, "{name}");
+        let rays = area_rays(&scene, &areas, 150, 5);
+        local += check_structure_trace(path.to_str().unwrap(), &experiments, &rays, &[], &dir);
+    }
+    assert!(
+        local > 0.0,
+        "no local BVH answered anything on any thesis scene"
+    );
+
+    // `build` takes the first config of the scene, and a scene without configs is an error.
+    let wood = scenes.join("thesis/WoodScene.obj");
+    let args = [
+        "build",
+        wood.to_str().unwrap(),
+        "--preset",
+        "full",
+        "--areas",
+        experiments.to_str().unwrap(),
+        "--json",
+    ];
+    let j = json_of(&rdbvh(&args));
+    assert_eq!(j["area_kind"], "plane");
+    assert!(j["triangles"].as_u64().unwrap() > 0, "{j}");
+    let cube = scenes.join("thesis/Cube.obj");
+    let args = [
+        "build",
+        cube.to_str().unwrap(),
+        "--preset",
+        "full",
+        "--areas",
+        experiments.to_str().unwrap(),
+    ];
+    let out = rdbvh(&args);
+    // The Cube's missing .mtl is a warning line before the error.
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let last = stderr.lines().last().unwrap_or("");
+    assert!(
+        last.starts_with("error: ") && last.contains("no [[config]] entry is for scene Cube.obj"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
 }

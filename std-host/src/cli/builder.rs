@@ -2,13 +2,18 @@
 
 use std::time::Instant;
 
+use clap::builder::PossibleValue;
 use clap::{value_parser, Args, ValueEnum};
-use rdbvh_core::build::{BuildArena, BuildConfig, BuildStats, Builder, MAX_BINS};
+use rdbvh_core::build::{
+    BuildArena, BuildConfig, BuildStats, Builder, Preset, PresetOptions, MAX_BINS,
+};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::heuristics::{AxisChooser, Sah, SahTermination};
-use rdbvh_core::BuildError;
+use rdbvh_core::influence::InfluenceArea;
 use serde::Serialize;
+
+use super::CliError;
 
 /// Which split axes the binned SAH builder tries.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Serialize)]
@@ -30,30 +35,66 @@ impl BuilderKind {
     }
 }
 
-/// How to build the BVH.
-#[derive(Args, Clone, Copy, Debug, PartialEq, Eq)]
-pub struct BuilderArgs {
-    /// Split axes: `sah` tries all three, `lsph` only the longest one.
-    #[arg(long, value_enum, default_value_t = BuilderKind::Sah)]
-    pub builder: BuilderKind,
-    /// Centroid bins per axis; each bin boundary is a candidate split plane.
-    #[arg(long, value_name = "N", default_value_t = BuildConfig::default().bins,
-          value_parser = value_parser!(u32).range(2..=i64::from(MAX_BINS)))]
-    pub bins: u32,
-    /// Largest leaf the SAH termination may keep when splitting would not be cheaper.
-    #[arg(long, value_name = "N", default_value_t = SahTermination::default().max_leaf,
-          value_parser = value_parser!(u32).range(1..))]
-    pub max_leaf: u32,
+/// A preset name on the command line: `sah`, `standard`, `facing`, `longest` or `full`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PresetArg(pub Preset);
+
+impl ValueEnum for PresetArg {
+    fn value_variants<'a>() -> &'a [Self] {
+        &[
+            PresetArg(Preset::Sah),
+            PresetArg(Preset::Standard),
+            PresetArg(Preset::Facing),
+            PresetArg(Preset::Longest),
+            PresetArg(Preset::Full),
+        ]
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        let help = match self.0 {
+            Preset::Sah => "binned SAH over all three axes (no area needed)",
+            Preset::Standard => "SAH + longest axis (LSPH), the thesis's standard (no area needed)",
+            Preset::Facing => "SAH + splitting plane facing (SPFH); needs --areas",
+            Preset::Longest => "PAH + LSPH; needs --areas",
+            Preset::Full => "PAH + SPFH, the thesis's full method; needs --areas",
+        };
+        Some(PossibleValue::new(self.0.name()).help(help))
+    }
 }
 
-impl Default for BuilderArgs {
-    fn default() -> Self {
-        Self {
-            builder: BuilderKind::Sah,
-            bins: BuildConfig::default().bins,
-            max_leaf: SahTermination::default().max_leaf,
-        }
+/// The name of the axis chooser a preset uses, as the `builder` report key spells it.
+pub fn chooser_name(preset: Preset) -> &'static str {
+    match preset {
+        Preset::Sah => "sah",
+        Preset::Standard | Preset::Longest => "lsph",
+        Preset::Facing | Preset::Full => "spfh",
     }
+}
+
+/// How to build the BVH: either `--builder` (the plain binned SAH builders) or `--preset` (the
+/// thesis's named heuristic pairs, built by `rdbvh-core`'s presets), not both.
+#[derive(Args, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BuilderArgs {
+    /// Split axes of the plain SAH builder: `sah` tries all three, `lsph` only the longest one
+    /// [default: sah].
+    #[arg(long, value_enum, conflicts_with = "preset")]
+    pub builder: Option<BuilderKind>,
+    /// Build with a named preset instead of --builder.
+    #[arg(long, value_name = "NAME")]
+    pub preset: Option<PresetArg>,
+    /// Build as the thesis did (presets only, including trace's local BVHs): candidate planes
+    /// uniform over the node box, 41 bins, leaves split down to 2 triangles by size alone.
+    #[arg(long, conflicts_with = "builder")]
+    pub thesis_mode: bool,
+    /// Centroid bins per axis; each bin boundary is a candidate split plane
+    /// [default: 16, or 41 with --thesis-mode].
+    #[arg(long, value_name = "N",
+          value_parser = value_parser!(u32).range(2..=i64::from(MAX_BINS)))]
+    pub bins: Option<u32>,
+    /// Largest leaf the termination may keep (with --thesis-mode: the leaf size it splits down
+    /// to) [default: 8, or 2 with --thesis-mode].
+    #[arg(long, value_name = "N", value_parser = value_parser!(u32).range(1..))]
+    pub max_leaf: Option<u32>,
 }
 
 /// A BVH with what its build reported and how long it took.
@@ -76,57 +117,165 @@ impl BuiltBvh {
 }
 
 impl BuilderArgs {
-    /// Builds a BVH over `triangles` (single-threaded, as the core's builder is).
-    pub fn build(&self, triangles: &[Triangle]) -> Result<BuiltBvh, BuildError> {
-        // Only the bins and the leaf size change: each builder keeps the rest of its own
-        // configuration (LSPH evaluates its first axis only, which a default config would undo).
-        match self.builder {
-            BuilderKind::Sah => timed_build(&self.apply(Builder::sah()), triangles),
-            BuilderKind::Lsph => timed_build(&self.apply(Builder::lsph()), triangles),
+    /// Plain binned SAH over `kind`'s axes with default settings.
+    pub fn plain(kind: BuilderKind) -> Self {
+        Self {
+            builder: Some(kind),
+            ..Self::default()
         }
     }
 
-    fn apply<A>(&self, mut b: Builder<A, Sah, SahTermination>) -> Builder<A, Sah, SahTermination> {
-        b.config.bins = self.bins;
-        b.termination.max_leaf = self.max_leaf;
+    /// The preset `preset` with default settings.
+    pub fn with_preset(preset: Preset) -> Self {
+        Self {
+            preset: Some(PresetArg(preset)),
+            ..Self::default()
+        }
+    }
+
+    /// The chosen preset, if --preset was given.
+    pub fn preset(&self) -> Option<Preset> {
+        self.preset.map(|p| p.0)
+    }
+
+    /// The plain builder's kind (sah unless --builder said otherwise).
+    pub fn kind(&self) -> BuilderKind {
+        self.builder.unwrap_or(BuilderKind::Sah)
+    }
+
+    /// The name of the split-axis chooser: `sah`, `lsph` or `spfh`.
+    pub fn chooser_name(&self) -> &'static str {
+        match self.preset() {
+            Some(p) => chooser_name(p),
+            None => self.kind().name(),
+        }
+    }
+
+    /// The preset settings: the project's defaults or the thesis's, then --bins and --max-leaf.
+    pub fn preset_options(&self) -> PresetOptions {
+        let mut o = if self.thesis_mode {
+            PresetOptions::thesis()
+        } else {
+            PresetOptions::default()
+        };
+        if let Some(bins) = self.bins {
+            o.bins = bins;
+        }
+        if let Some(max_leaf) = self.max_leaf {
+            o.max_leaf = max_leaf;
+        }
+        o
+    }
+
+    /// Bins per axis of the build.
+    pub fn bins(&self) -> u32 {
+        match self.preset() {
+            Some(_) => self.preset_options().bins,
+            None => self.bins.unwrap_or(BuildConfig::default().bins),
+        }
+    }
+
+    /// The largest leaf of the build.
+    pub fn max_leaf(&self) -> u32 {
+        match self.preset() {
+            Some(_) => self.preset_options().max_leaf,
+            None => self.max_leaf.unwrap_or(SahTermination::default().max_leaf),
+        }
+    }
+
+    /// A usage error when the preset needs an influence area and `has_area` is false, or when
+    /// --thesis-mode has no preset to apply to, so the command can say so before loading anything.
+    pub fn check_area(&self, has_area: bool) -> Result<(), CliError> {
+        if self.thesis_mode && self.preset().is_none() {
+            return Err(CliError::Usage(
+                "--thesis-mode applies to presets: give --preset NAME".into(),
+            ));
+        }
+        match self.preset() {
+            Some(p) if p.needs_area() && !has_area => Err(CliError::Usage(format!(
+                "preset `{p}` uses PAH or SPFH, which need the rays' influence area: give \
+                 --areas AREAS.toml (or use --preset sah or standard)"
+            ))),
+            _ => Ok(()),
+        }
+    }
+
+    /// Builds a BVH over all `triangles` (single-threaded, as the core's builder is).
+    pub fn build(&self, triangles: &[Triangle]) -> Result<BuiltBvh, CliError> {
+        self.build_over(triangles, None, None)
+    }
+
+    /// Builds a BVH over the triangles of `triangles` whose ids `subset` lists (all when
+    /// `None`), for the influence area `area` when the preset needs one.
+    pub fn build_over(
+        &self,
+        triangles: &[Triangle],
+        subset: Option<&[u32]>,
+        area: Option<&InfluenceArea>,
+    ) -> Result<BuiltBvh, CliError> {
+        self.check_area(area.is_some())?;
+        let n = subset.map_or(triangles.len(), <[u32]>::len);
+        let mut arena = BuildArena::with_capacity(n);
+        let mut bvh = Bvh::with_capacity(n);
+        let start = Instant::now();
+        match subset {
+            Some(ids) => arena.load_triangle_subset(triangles, ids.iter().copied())?,
+            None => arena.load_triangles(triangles)?,
+        }
+        let stats = match self.preset() {
+            Some(p) => p.build_into(area, &self.preset_options(), &mut arena, &mut bvh)?,
+            // Only the bins and the leaf size change: each builder keeps the rest of its own
+            // configuration (LSPH evaluates its first axis only, which a default config would
+            // undo).
+            None => match self.kind() {
+                BuilderKind::Sah => self
+                    .apply(Builder::sah())
+                    .build_into(&mut arena, &mut bvh)?,
+                BuilderKind::Lsph => self
+                    .apply(Builder::lsph())
+                    .build_into(&mut arena, &mut bvh)?,
+            },
+        };
+        let seconds = start.elapsed().as_secs_f64();
+        Ok(BuiltBvh {
+            bvh,
+            stats,
+            seconds,
+        })
+    }
+
+    fn apply<A: AxisChooser>(
+        &self,
+        mut b: Builder<A, Sah, SahTermination>,
+    ) -> Builder<A, Sah, SahTermination> {
+        b.config.bins = self.bins();
+        b.termination.max_leaf = self.max_leaf();
         b
     }
-}
-
-fn timed_build<A: AxisChooser>(
-    builder: &Builder<A, Sah, SahTermination>,
-    triangles: &[Triangle],
-) -> Result<BuiltBvh, BuildError> {
-    let mut arena = BuildArena::with_capacity(triangles.len());
-    let mut bvh = Bvh::with_capacity(triangles.len());
-    let start = Instant::now();
-    arena.load_triangles(triangles)?;
-    let stats = builder.build_into(&mut arena, &mut bvh)?;
-    let seconds = start.elapsed().as_secs_f64();
-    Ok(BuiltBvh {
-        bvh,
-        stats,
-        seconds,
-    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rdbvh_core::influence::PlaneArea;
     use rdbvh_core::Vec3;
 
-    #[test]
-    fn both_builders_cover_every_triangle() {
-        let tris: Vec<Triangle> = (0..100)
+    fn row(n: usize) -> Vec<Triangle> {
+        (0..n)
             .map(|i| {
                 let o = Vec3::new(i as f32, (i % 7) as f32, (i % 3) as f32);
                 Triangle::new(o, o + Vec3::X, o + Vec3::Y)
             })
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn both_builders_cover_every_triangle() {
+        let tris = row(100);
         for builder in [BuilderKind::Sah, BuilderKind::Lsph] {
             let args = BuilderArgs {
-                builder,
-                max_leaf: 2,
+                builder: Some(builder),
+                max_leaf: Some(2),
                 ..BuilderArgs::default()
             };
             let built = args.build(&tris).unwrap();
@@ -142,9 +291,10 @@ mod tests {
     #[test]
     fn lsph_keeps_its_own_cut_evaluation() {
         let args = BuilderArgs {
-            builder: BuilderKind::Lsph,
-            bins: 8,
-            max_leaf: 3,
+            builder: Some(BuilderKind::Lsph),
+            bins: Some(8),
+            max_leaf: Some(3),
+            ..BuilderArgs::default()
         };
         let b = args.apply(Builder::lsph());
         assert_eq!(b.config.cut, Builder::lsph().config.cut);
@@ -152,13 +302,63 @@ mod tests {
         // And the two builders really differ on a scene where the longest axis is a poor choice.
         let tris = crate::scene::thesis_random_triangles(0, 1000);
         let sah = BuilderArgs::default().build(&tris).unwrap().bvh;
-        let lsph = BuilderArgs {
-            builder: BuilderKind::Lsph,
-            ..BuilderArgs::default()
-        }
-        .build(&tris)
-        .unwrap()
-        .bvh;
+        let lsph = BuilderArgs::plain(BuilderKind::Lsph)
+            .build(&tris)
+            .unwrap()
+            .bvh;
         assert_ne!(sah.nodes(), lsph.nodes());
+    }
+
+    #[test]
+    fn presets_build_subsets_and_thesis_mode_is_overridable() {
+        let tris = row(200);
+        let area: InfluenceArea =
+            PlaneArea::new(Vec3::new(50.0, 3.0, -1.0), Vec3::Z, 20.0, 5.0, 5.0)
+                .unwrap()
+                .into();
+        let ids: Vec<u32> = (0..200u32)
+            .filter(|&i| area.overlaps_triangle(&tris[i as usize]))
+            .collect();
+        assert!(ids.len() > 10 && ids.len() < 100, "{}", ids.len());
+        for preset in Preset::ALL {
+            let mut args = BuilderArgs::with_preset(preset);
+            args.thesis_mode = true;
+            let built = args.build_over(&tris, Some(&ids), Some(&area)).unwrap();
+            let mut leaves: Vec<u32> = built.bvh.prim_indices().to_vec();
+            leaves.sort_unstable();
+            assert_eq!(leaves, ids, "{preset}: exactly the subset");
+            assert!(built.bvh.nodes().iter().all(|n| n.count <= 2), "{preset}");
+        }
+        let thesis = BuilderArgs {
+            thesis_mode: true,
+            max_leaf: Some(5),
+            ..BuilderArgs::with_preset(Preset::Full)
+        };
+        let o = thesis.preset_options();
+        assert!(o.thesis_mode);
+        assert_eq!((o.bins, o.max_leaf), (PresetOptions::thesis().bins, 5));
+        assert_eq!((thesis.bins(), thesis.max_leaf()), (o.bins, 5));
+        assert_eq!(thesis.chooser_name(), "spfh");
+        let d = BuilderArgs::default();
+        assert_eq!((d.bins(), d.max_leaf(), d.chooser_name()), (16, 8, "sah"));
+    }
+
+    #[test]
+    fn presets_that_need_an_area_say_so_before_building() {
+        let tris = row(10);
+        for preset in Preset::ALL {
+            let args = BuilderArgs::with_preset(preset);
+            match args.build(&tris) {
+                Ok(_) => assert!(!preset.needs_area(), "{preset}"),
+                Err(CliError::Usage(why)) => {
+                    assert!(preset.needs_area(), "{preset}");
+                    assert!(
+                        why.contains("--areas") && why.contains(preset.name()),
+                        "{why}"
+                    );
+                }
+                Err(e) => panic!("{preset}: {e}"),
+            }
+        }
     }
 }

@@ -1,19 +1,25 @@
 //! `rdbvh` with no arguments: a short, self-checking run of the main job on built-in scenes.
 //!
 //! It does what a renderer with next event estimation does, small: build SAH and LSPH BVHs over a
-//! lit room, shoot camera-like rays and shadow rays towards the ceiling light, and check every
-//! answer against brute force, so a first run both shows the tool and proves it works here.
+//! lit room, shoot camera-like rays and shadow rays towards the ceiling light, then build the
+//! scene structure (a `full` local BVH over a plane influence area below the light, an octree and
+//! a fallback BVH) and trace the light's parallel rays and unrelated rays through it. Every answer
+//! is checked against brute force, so a first run both shows the tool and proves it works here.
 
 use std::io::Write;
 use std::time::Instant;
 
 use rayon::prelude::*;
 use rdbvh_core::brute_force;
+use rdbvh_core::build::Preset;
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::{CostConstants, Sah};
+use rdbvh_core::influence::{InfluenceArea, PlaneArea, RaySampler};
+use rdbvh_core::toplevel::{Scene as Structure, SceneOptions, DEFAULT_OCTREE_LEVELS};
 use rdbvh_core::Vec3;
 
 use super::builder::{BuilderArgs, BuilderKind, BuiltBvh};
+use super::structure::trace_structure;
 use super::trace::{trace, Answers};
 use super::{load_scene, CliError};
 use crate::scene::{Mt19937, Scene};
@@ -56,10 +62,7 @@ pub fn run(out: &mut impl Write) -> Result<(), CliError> {
         )?;
         let mut bvhs = Vec::new();
         for kind in [BuilderKind::Sah, BuilderKind::Lsph] {
-            let args = BuilderArgs {
-                builder: kind,
-                ..BuilderArgs::default()
-            };
+            let args = BuilderArgs::plain(kind);
             let built = args.build(&scene.triangles)?;
             w(out, format!("  {}", stats_row(kind, &built, scene.len())))?;
             bvhs.push((kind, built));
@@ -100,13 +103,89 @@ pub fn run(out: &mut impl Write) -> Result<(), CliError> {
             )?;
         }
     }
+    checked += structure(out)?;
     w(
         out,
         format!(
-            "\nall {checked} queries agree with brute force on both builders, on {} threads",
+            "\nall {checked} queries agree with brute force on both builders and through the \
+             scene structure, on {} threads",
             rayon::current_num_threads()
         ),
     )
+}
+
+/// The room's influence area: parallel rays straight down from just below the 2 x 2 ceiling
+/// light to the floor, as an area file would give it:
+/// `kind = "plane"`, `center = [5, 9.9, 5]`, `normal = [0, -1, 0]`, `half_width = 1`,
+/// `half_height = 1`, `depth = 9.9`.
+pub fn room_light_area() -> Result<InfluenceArea, CliError> {
+    PlaneArea::new(Vec3::new(5.0, 9.9, 5.0), -Vec3::Y, 1.0, 1.0, 9.9)
+        .map(InfluenceArea::from)
+        .map_err(|e| CliError::Mismatch(format!("the demo's own area is invalid: {e}")))
+}
+
+/// Builds the scene structure over the room with a `full` local BVH for the light's area, traces
+/// the area's rays and unrelated rays through it, and returns how many queries it checked.
+fn structure(out: &mut impl Write) -> Result<usize, CliError> {
+    let w = |out: &mut dyn Write, text: String| writeln!(out, "{text}").map_err(CliError::Stdout);
+    let (scene, _) = load_scene("builtin:room")?;
+    let area = room_light_area()?;
+    let options = SceneOptions {
+        preset: Preset::Full,
+        ..SceneOptions::default()
+    };
+    let start = Instant::now();
+    let s = Structure::with_octree(
+        &scene.triangles,
+        vec![area],
+        &options,
+        DEFAULT_OCTREE_LEVELS,
+    )?;
+    let build_s = start.elapsed().as_secs_f64();
+    w(
+        out,
+        format!(
+            "\n{} with a scene structure: a `full` (PAH + SPFH) local BVH over the {} triangles \
+             of a plane area below the light, an octree and a SAH fallback BVH, built in {:.2} ms",
+            scene.name,
+            s.triangles_per_area()[0],
+            build_s * 1e3
+        ),
+    )?;
+    let along_normal: Vec<Ray> = RaySampler::new(area, 11).take(RAYS).collect();
+    let unrelated = batches(&scene).swap_remove(0).rays;
+    let mut checked = 0;
+    for (what, rays) in [
+        ("rays from the light along its normal", along_normal),
+        ("camera rays, unrelated to the area,", unrelated),
+    ] {
+        let t = trace_structure(&s, &scene.triangles, &rays, false, CostConstants::default());
+        let batch = Batch {
+            what,
+            rays,
+            any_hit: false,
+        };
+        let expected = brute(&scene.triangles, &batch);
+        if let Some(i) = first_difference(&t.answers, &expected) {
+            return Err(CliError::Mismatch(format!(
+                "{} {what}, scene structure, ray {i}: {:?}",
+                scene.name, batch.rays[i]
+            )));
+        }
+        checked += batch.rays.len();
+        w(
+            out,
+            format!(
+                "  {} {what} (closest hit): local hit rate {:.1}%, mean cost {:.2} with the \
+                 structure vs {:.2} with the fallback BVH alone, same answers as brute force",
+                batch.rays.len(),
+                100.0 * t.local_hit_rate(batch.rays.len()),
+                t.cost_structure,
+                t.cost_fallback
+            ),
+        )?;
+    }
+    Ok(checked)
 }
 
 fn stats_row(kind: BuilderKind, b: &BuiltBvh, triangles: usize) -> String {

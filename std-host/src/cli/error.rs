@@ -5,9 +5,12 @@ use std::fmt;
 use std::io;
 use std::path::PathBuf;
 
+use rdbvh_core::build::PresetError;
+use rdbvh_core::toplevel::SceneError as StructureError;
 use rdbvh_core::BuildError;
 
 use super::rays::RaysError;
+use crate::areas::AreasError;
 use crate::scene::SceneError;
 
 /// Why a command failed.
@@ -19,6 +22,13 @@ pub enum CliError {
     Build(BuildError),
     /// The rays file is unusable.
     Rays(RaysError),
+    /// The area file is unusable.
+    Areas(AreasError),
+    /// The scene structure (local BVHs, lookup, fallback BVH) could not be built.
+    Structure(StructureError),
+    /// The command line asks for something impossible that clap cannot see (a preset that needs
+    /// an area without --areas): exit status 2, like clap's own usage errors.
+    Usage(String),
     /// An output file could not be written.
     Write {
         /// The file.
@@ -38,6 +48,9 @@ impl fmt::Display for CliError {
             CliError::Scene(e) => e.fmt(f),
             CliError::Build(e) => write!(f, "BVH build failed: {e}"),
             CliError::Rays(e) => e.fmt(f),
+            CliError::Areas(e) => e.fmt(f),
+            CliError::Structure(e) => write!(f, "scene structure build failed: {e}"),
+            CliError::Usage(why) => write!(f, "{why} (see rdbvh --help)"),
             CliError::Write { path, source } => {
                 write!(f, "cannot write {}: {source}", path.display())
             }
@@ -52,8 +65,12 @@ impl std::error::Error for CliError {
         match self {
             CliError::Scene(e) => Some(e),
             CliError::Rays(e) => Some(e),
+            CliError::Areas(e) => Some(e),
             CliError::Write { source, .. } | CliError::Stdout(source) => Some(source),
-            CliError::Build(_) | CliError::Mismatch(_) => None,
+            CliError::Build(_)
+            | CliError::Structure(_)
+            | CliError::Usage(_)
+            | CliError::Mismatch(_) => None,
         }
     }
 }
@@ -73,5 +90,30 @@ impl From<BuildError> for CliError {
 impl From<RaysError> for CliError {
     fn from(e: RaysError) -> Self {
         CliError::Rays(e)
+    }
+}
+
+impl From<AreasError> for CliError {
+    fn from(e: AreasError) -> Self {
+        CliError::Areas(e)
+    }
+}
+
+impl From<StructureError> for CliError {
+    fn from(e: StructureError) -> Self {
+        CliError::Structure(e)
+    }
+}
+
+impl From<PresetError> for CliError {
+    fn from(e: PresetError) -> Self {
+        match e {
+            // Commands check this before loading anything; this is the backstop.
+            PresetError::NeedsArea(p) => CliError::Usage(format!(
+                "preset `{p}` uses PAH or SPFH, which need the rays' influence area: give \
+                 --areas AREAS.toml"
+            )),
+            PresetError::Build(e) => CliError::Build(e),
+        }
     }
 }

@@ -1,22 +1,27 @@
-//! The `rdbvh` command line: `build` and `trace` over OBJ files or built-in scenes, and a
-//! self-checking demo when run with no arguments.
+//! The `rdbvh` command line: `build` and `trace` over OBJ files or built-in scenes, optionally
+//! with influence areas (local BVHs, the scene structure), and a self-checking demo when run with
+//! no arguments.
 //!
 //! Output contracts are measured from outside (scripts parse `build --json` and the CSV files), so
 //! they are kept stable: see each command's documentation. Every failure is one line on standard
 //! error, `error: ...`, and a non-zero exit status: 2 for a bad command line, 1 for anything else.
 
+mod areas;
 mod build;
 mod builder;
 mod demo;
 mod error;
+mod help;
 mod rays;
+mod structure;
 mod trace;
 
 pub use build::{BuildArgs, BuildReport};
-pub use builder::{BuilderArgs, BuilderKind, BuiltBvh};
+pub use builder::{chooser_name, BuilderArgs, BuilderKind, BuiltBvh, PresetArg};
 pub use error::CliError;
 pub use rays::{parse_rays, read_rays, RaysError, OPTIONAL_COLUMNS, REQUIRED_COLUMNS};
-pub use trace::{trace, Answers, TraceArgs};
+pub use structure::{trace_structure, StructureTrace, DEFAULT_LOCAL_PRESET};
+pub use trace::{trace, Answers, LookupKind, TraceArgs};
 
 use std::ffi::OsString;
 use std::io::{self, Write};
@@ -27,18 +32,9 @@ use clap::{Parser, Subcommand};
 
 use crate::scene::Scene;
 
-const SCENES_HELP: &str = "\
-Scenes: SCENE.obj is a Wavefront OBJ file (triangulated, all objects in file order; its .mtl
-gives material names and emissive flags, and a missing .mtl is only a warning), or one of:
-  builtin:random100    the thesis's Random100 (100 random triangles, std::mt19937 seed 1)
-  builtin:random1000   the thesis's Random1000 (the next 1000 triangles of that stream)
-  builtin:room         a closed room with an emissive ceiling light and three boxes
-
-Run with no arguments for a short demo that checks itself against brute force.";
-
 /// Ray-distribution-aware BVHs: build and trace over OBJ scenes.
 #[derive(Parser, Debug)]
-#[command(name = "rdbvh", version, after_help = SCENES_HELP)]
+#[command(name = "rdbvh", version, after_help = help::top())]
 pub struct Cli {
     /// What to do; none runs the demo.
     #[command(subcommand)]
@@ -48,9 +44,13 @@ pub struct Cli {
 /// The subcommands.
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// Build a BVH and report nodes, leaves, depth, SAH cost, memory and build speed.
+    /// Build a BVH (over the scene, or over the triangles of an influence area) and report
+    /// nodes, leaves, depth, SAH and PAH cost, memory and build speed.
+    #[command(after_help = help::build())]
     Build(BuildArgs),
-    /// Trace rays from a CSV file and write the closest (or any) hit of each to a CSV file.
+    /// Trace rays from a CSV file and write the closest (or any) hit of each to a CSV file, with
+    /// one BVH or through the scene structure of influence areas.
+    #[command(after_help = help::trace())]
     Trace(TraceArgs),
 }
 
@@ -77,6 +77,10 @@ where
         Ok(()) => ExitCode::SUCCESS,
         // A closed pipe (`rdbvh build x | head -1`) is the reader's choice, not a failure.
         Err(CliError::Stdout(e)) if e.kind() == io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+        Err(e @ CliError::Usage(_)) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE

@@ -1,18 +1,30 @@
-//! `rdbvh trace`: answer a batch of ray queries from a CSV file, in parallel, in input order.
+//! `rdbvh trace`: answer a batch of ray queries from a CSV file, in parallel, in input order,
+//! with one BVH over the scene or (with `--areas`) through the scene structure of influence
+//! areas, local BVHs and a fallback BVH.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use clap::Args;
+use clap::{value_parser, Args, ValueEnum};
 use rayon::prelude::*;
 use rdbvh_core::bvh::{Bvh, Hit};
 use rdbvh_core::geometry::{Ray, Triangle};
+use rdbvh_core::toplevel::{DEFAULT_OCTREE_LEVELS, MAX_OCTREE_LEVELS};
 
 use super::builder::BuilderArgs;
 use super::rays::read_rays;
-use super::{load_scene, CliError};
+use super::{load_scene, structure, CliError};
+
+/// How the scene structure finds the areas that may contain a ray's origin.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LookupKind {
+    /// An octree over the areas: constant time per query.
+    Octree,
+    /// Every area is a candidate: the naive baseline.
+    List,
+}
 
 /// Arguments of `rdbvh trace`.
 #[derive(Args, Clone, Debug)]
@@ -30,9 +42,25 @@ pub struct TraceArgs {
     /// Answer "is anything hit on [tmin, tmax]" (shadow rays) instead of the closest hit.
     #[arg(long)]
     pub any_hit: bool,
-    /// How to build the BVH.
+    /// How to build the BVH (with --areas: the local BVHs, which need --preset; the fallback
+    /// BVH is always binned SAH with default settings).
     #[command(flatten)]
     pub builder: BuilderArgs,
+    /// Influence areas (TOML): answer through the scene structure, with a local BVH over the
+    /// triangles of each area that applies to the scene and a fallback BVH for other rays.
+    #[arg(long, value_name = "AREAS.toml")]
+    pub areas: Option<PathBuf>,
+    /// With --areas: how a ray's origin finds its candidate areas.
+    #[arg(long, value_enum, default_value_t = LookupKind::Octree, requires = "areas")]
+    pub lookup: LookupKind,
+    /// With --areas and the octree lookup: its maximum number of levels.
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_OCTREE_LEVELS, requires = "areas",
+          value_parser = value_parser!(u32).range(1..=i64::from(MAX_OCTREE_LEVELS)))]
+    pub octree_levels: u32,
+    /// With --areas: how many affine areas a ray tries before the fallback BVH.
+    #[arg(long, value_name = "K", default_value_t = 1, requires = "areas",
+          value_parser = value_parser!(u32).range(1..))]
+    pub max_tries: u32,
 }
 
 /// The answers of one batch, in ray order.
@@ -92,6 +120,10 @@ pub fn trace(bvh: &Bvh, triangles: &[Triangle], rays: &[Ray], any_hit: bool) -> 
 
 /// Runs `rdbvh trace`; the summary goes to `log` (standard error), so standard output stays free.
 pub fn run(args: &TraceArgs, log: &mut impl Write) -> Result<(), CliError> {
+    if let Some(areas) = &args.areas {
+        return structure::run(args, areas, log);
+    }
+    args.builder.check_area(false)?;
     let (scene, _) = load_scene(&args.scene)?;
     let rays = read_rays(&args.rays)?;
     let built = args.builder.build(&scene.triangles)?;
@@ -125,7 +157,8 @@ pub fn run(args: &TraceArgs, log: &mut impl Write) -> Result<(), CliError> {
     .map_err(CliError::Stdout)
 }
 
-fn write_answers(path: &Path, answers: &Answers) -> Result<(), CliError> {
+/// Writes `answers` to the CSV file at `path`.
+pub(super) fn write_answers(path: &Path, answers: &Answers) -> Result<(), CliError> {
     let error = |source| CliError::Write {
         path: path.to_path_buf(),
         source,

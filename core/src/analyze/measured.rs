@@ -17,8 +17,9 @@ pub struct StructureAllHit {
 }
 
 /// The all-hit walk through the structure, as the thesis measured its "real cost": the first
-/// affine candidate area's local BVH is walked over `[t_min, t_exit]` with no early exit; if no
-/// triangle there is hit, the fallback BVH is walked over the rest of the segment.
+/// affine candidate area (origin inside, direction within the tolerance) has its local BVH walked
+/// over `[t_min, t_exit]` with no early exit; if no triangle there is hit, the fallback BVH is
+/// walked over the rest of the segment.
 pub fn structure_all_hit<L: AreaLookup>(
     scene: &Scene<L>,
     ray: &Ray,
@@ -31,8 +32,11 @@ pub fn structure_all_hit<L: AreaLookup>(
         if !area.is_affine(ray) {
             return None;
         }
-        let (t0, t1) = area.polytope().clip_ray(ray)?;
-        (t0 <= ray.t_min).then_some((a, t1))
+        // `is_affine` has already found the origin inside (with its tolerance); the clipped
+        // entry of a ray starting on the area's boundary (a light's rectangle, a frustum's near
+        // plane) may round a hair past `t_min`, so only the exit is taken from the clip.
+        let (_, t1) = area.polytope().clip_ray(ray)?;
+        Some((a, t1))
     });
     if let Some((a, t_exit)) = affine {
         let segment = Ray {

@@ -11,68 +11,102 @@ use crate::geometry::{Aabb, Triangle};
 use crate::simd::Aabb4;
 use crate::BuildError;
 
-/// Primitive references as a structure of arrays: the binning loop streams through the bounds, and
-/// the partition swaps entries in place, so the working set of a node is always contiguous.
+/// One primitive reference: its bounds as two 16-byte lanes `(x, y, z, id bits)`, 32 bytes.
+///
+/// Every loop of the build reads a primitive's whole box at once (binning grows three bins by it,
+/// the partition moves it), so the six bounds and the id share one record: two aligned loads, one
+/// 32-byte swap. A structure of arrays (seven arrays) cost the partition seven scattered swaps per
+/// moved primitive and the binning six gathers; measured with callgrind on the bunny's SAH build,
+/// this layout takes markedly fewer instructions (see the speed issue's note).
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C, align(16))]
+pub(crate) struct PrimRef {
+    /// `min.x, min.y, min.z`, then the id's bits.
+    lo: [f32; 4],
+    /// `max.x, max.y, max.z`, then zero.
+    hi: [f32; 4],
+}
+
+impl PrimRef {
+    #[inline(always)]
+    fn new(id: u32, b: &Aabb) -> Self {
+        Self {
+            lo: [b.min.x, b.min.y, b.min.z, f32::from_bits(id)],
+            hi: [b.max.x, b.max.y, b.max.z, 0.0],
+        }
+    }
+
+    /// The lower corner as a lane; lane 3 holds the id's bits and must be ignored.
+    #[inline(always)]
+    pub fn lo4(&self) -> f32x4 {
+        f32x4::from(self.lo)
+    }
+
+    /// The upper corner as a lane; lane 3 is zero.
+    #[inline(always)]
+    pub fn hi4(&self) -> f32x4 {
+        f32x4::from(self.hi)
+    }
+
+    /// The primitive id.
+    #[inline(always)]
+    pub fn id(&self) -> u32 {
+        self.lo[3].to_bits()
+    }
+}
+
+/// The primitive references of a build, permuted in place into leaf order.
 #[derive(Debug, Default)]
 pub(crate) struct PrimRefs {
-    /// Primitive ids, permuted into leaf order by the build.
-    pub ids: Vec<u32>,
-    /// Lower corners per axis.
-    pub lo: [Vec<f32>; 3],
-    /// Upper corners per axis.
-    pub hi: [Vec<f32>; 3],
+    refs: Vec<PrimRef>,
 }
 
 impl PrimRefs {
     fn with_capacity(n: usize) -> Self {
-        let v = || Vec::<f32>::with_capacity(n);
         Self {
-            ids: Vec::with_capacity(n),
-            lo: [v(), v(), v()],
-            hi: [v(), v(), v()],
+            refs: Vec::with_capacity(n),
         }
     }
 
     fn clear(&mut self) {
-        self.ids.clear();
-        for a in 0..3 {
-            self.lo[a].clear();
-            self.hi[a].clear();
-        }
+        self.refs.clear();
     }
 
-    /// Twice the centroid of primitive slot `i` (the factor 1/2 cancels in every use).
     #[inline(always)]
-    pub fn centroid2(&self, i: usize) -> Vec3 {
-        Vec3::new(
-            self.lo[0][i] + self.hi[0][i],
-            self.lo[1][i] + self.hi[1][i],
-            self.lo[2][i] + self.hi[2][i],
-        )
+    pub fn len(&self) -> usize {
+        self.refs.len()
+    }
+
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> &PrimRef {
+        &self.refs[i]
+    }
+
+    /// The ids in slot order.
+    pub fn ids(&self) -> impl Iterator<Item = u32> + '_ {
+        self.refs.iter().map(PrimRef::id)
     }
 
     /// Twice the centroid of slot `i` along `axis` only.
     #[inline(always)]
     pub fn centroid2_axis(&self, i: usize, axis: usize) -> f32 {
-        self.lo[axis][i] + self.hi[axis][i]
+        let r = &self.refs[i];
+        r.lo[axis] + r.hi[axis]
     }
 
     /// The bounds of slot `i`.
     #[inline(always)]
     pub fn bounds(&self, i: usize) -> Aabb {
+        let r = &self.refs[i];
         Aabb::new(
-            Vec3::new(self.lo[0][i], self.lo[1][i], self.lo[2][i]),
-            Vec3::new(self.hi[0][i], self.hi[1][i], self.hi[2][i]),
+            Vec3::new(r.lo[0], r.lo[1], r.lo[2]),
+            Vec3::new(r.hi[0], r.hi[1], r.hi[2]),
         )
     }
 
     #[inline(always)]
     pub fn swap(&mut self, i: usize, j: usize) {
-        self.ids.swap(i, j);
-        for a in 0..3 {
-            self.lo[a].swap(i, j);
-            self.hi[a].swap(i, j);
-        }
+        self.refs.swap(i, j);
     }
 }
 
@@ -109,12 +143,13 @@ impl Bin {
     }
 }
 
-/// One side of every bin boundary of a sweep, as SoA lanes: boundary `i`'s box and count. Padded
-/// by three lanes so the last group of four can always be loaded.
+/// One side of every bin boundary of a sweep: boundary `i`'s box as `(x, y, z, _)` lanes and its
+/// count. Padded by three entries so the last group of four can always be loaded; four boxes are
+/// transposed into SoA lanes for pricing.
 #[derive(Debug)]
 pub(crate) struct SweepSide {
-    min: [[f32; SWEEP_LANES]; 3],
-    max: [[f32; SWEEP_LANES]; 3],
+    min: [f32x4; SWEEP_LANES],
+    max: [f32x4; SWEEP_LANES],
     pub count: [u32; SWEEP_LANES],
 }
 
@@ -123,38 +158,47 @@ const SWEEP_LANES: usize = MAX_BINS as usize + 4;
 impl SweepSide {
     const fn new() -> Self {
         Self {
-            min: [[0.0; SWEEP_LANES]; 3],
-            max: [[0.0; SWEEP_LANES]; 3],
+            min: [f32x4::splat(f32::INFINITY); SWEEP_LANES],
+            max: [f32x4::splat(f32::NEG_INFINITY); SWEEP_LANES],
             count: [0; SWEEP_LANES],
         }
     }
 
     #[inline(always)]
     pub fn set(&mut self, i: usize, bin: &Bin) {
-        let (lo, hi) = (bin.min.to_array(), bin.max.to_array());
-        for k in 0..3 {
-            self.min[k][i] = lo[k];
-            self.max[k][i] = hi[k];
-        }
+        self.min[i] = bin.min;
+        self.max[i] = bin.max;
         self.count[i] = bin.count;
     }
 
     #[inline(always)]
     pub fn bounds(&self, i: usize) -> Aabb {
+        let (lo, hi) = (self.min[i].to_array(), self.max[i].to_array());
         Aabb::new(
-            Vec3::new(self.min[0][i], self.min[1][i], self.min[2][i]),
-            Vec3::new(self.max[0][i], self.max[1][i], self.max[2][i]),
+            Vec3::new(lo[0], lo[1], lo[2]),
+            Vec3::new(hi[0], hi[1], hi[2]),
         )
     }
 
     /// The measures and counts of boundaries `i..i + 4`.
     #[inline(always)]
     pub fn lanes<M: crate::heuristics::CostModel>(&self, i: usize, model: &M) -> (f32x4, f32x4) {
-        let lane = |a: &[f32; SWEEP_LANES]| -> [f32; 4] { [a[i], a[i + 1], a[i + 2], a[i + 3]] };
-        let b4 = Aabb4::load(
-            &[lane(&self.min[0]), lane(&self.min[1]), lane(&self.min[2])],
-            &[lane(&self.max[0]), lane(&self.max[1]), lane(&self.max[2])],
-        );
+        let [min_x, min_y, min_z, _] = f32x4::transpose([
+            self.min[i],
+            self.min[i + 1],
+            self.min[i + 2],
+            self.min[i + 3],
+        ]);
+        let [max_x, max_y, max_z, _] = f32x4::transpose([
+            self.max[i],
+            self.max[i + 1],
+            self.max[i + 2],
+            self.max[i + 3],
+        ]);
+        let b4 = Aabb4 {
+            min: [min_x, min_y, min_z],
+            max: [max_x, max_y, max_z],
+        };
         let c = &self.count;
         let n = f32x4::from([
             c[i] as f32,
@@ -227,18 +271,18 @@ impl BuildArena {
 
     /// How many primitives are loaded.
     pub fn len(&self) -> usize {
-        self.refs.ids.len()
+        self.refs.len()
     }
 
     /// True when no primitive is loaded.
     pub fn is_empty(&self) -> bool {
-        self.refs.ids.is_empty()
+        self.refs.len() == 0
     }
 
     /// The id and bounds in primitive slot `slot` (in the order a build left them), or `None`
     /// past the loaded primitives.
     pub fn prim(&self, slot: usize) -> Option<(u32, Aabb)> {
-        (slot < self.len()).then(|| (self.refs.ids[slot], self.refs.bounds(slot)))
+        (slot < self.len()).then(|| (self.refs.get(slot).id(), self.refs.bounds(slot)))
     }
 
     /// Forgets the loaded primitives, keeping the memory.
@@ -251,7 +295,7 @@ impl BuildArena {
     /// Adds a primitive with id `id` and bounds `bounds`. Fails when the arena is full or the
     /// bounds are empty or not finite (a NaN or infinite vertex).
     pub fn push(&mut self, id: u32, bounds: Aabb) -> Result<(), BuildError> {
-        if self.refs.ids.len() >= self.capacity {
+        if self.refs.len() >= self.capacity {
             return Err(BuildError::ArenaFull {
                 capacity: self.capacity,
             });
@@ -259,11 +303,7 @@ impl BuildArena {
         if !bounds.is_valid() {
             return Err(BuildError::InvalidPrimitive { index: id });
         }
-        self.refs.ids.push(id);
-        for a in 0..3 {
-            self.refs.lo[a].push(bounds.min[a]);
-            self.refs.hi[a].push(bounds.max[a]);
-        }
+        self.refs.refs.push(PrimRef::new(id, &bounds));
         self.bounds = self.bounds.union(bounds);
         self.centroids = self.centroids.grown(bounds.min + bounds.max);
         Ok(())

@@ -304,7 +304,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                 None => break,
             }
         }
-        out.prim_indices.extend_from_slice(&arena.refs.ids);
+        out.prim_indices.extend(arena.refs.ids());
         out.max_depth = stats.max_depth;
         stats.nodes = out.nodes.len() as u32;
         Ok(stats)
@@ -485,8 +485,8 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         let active = [maps[0].is_some(), maps[1].is_some(), maps[2].is_some()];
         let refs = &arena.refs;
         for i in task.start as usize..(task.start + task.count) as usize {
-            let lo = f32x4::from([refs.lo[0][i], refs.lo[1][i], refs.lo[2][i], 0.0]);
-            let hi = f32x4::from([refs.hi[0][i], refs.hi[1][i], refs.hi[2][i], 0.0]);
+            let r = refs.get(i);
+            let (lo, hi) = (r.lo4(), r.hi4());
             let index = ((lo + hi - min) * scale)
                 .fast_max(f32x4::ZERO)
                 .fast_min(last)
@@ -528,17 +528,31 @@ fn sweep_axis<M: CostModel>(
         sweep.left.set(i, &Bin::EMPTY);
         sweep.right.set(i, &Bin::EMPTY);
     }
-    let mut best: Option<(f32, usize)> = None;
+    // The cheapest boundary per lane, then across lanes. Boundaries with an empty side, and the
+    // padding lanes past the last boundary (count 0), price as +inf. Strict `<` keeps the first
+    // of equal prices in each lane, and the final reduction the lowest boundary among them, so
+    // ties always go to the lowest boundary.
+    let inf = f32x4::splat(f32::INFINITY);
+    let zero = f32x4::ZERO;
+    let (mut best_w, mut best_i) = (inf, f32x4::splat(-1.0));
+    let mut index = f32x4::from([1.0, 2.0, 3.0, 4.0]);
     for i in (1..nb).step_by(4) {
         let (ml, nl) = sweep.left.lanes(i, model);
         let (mr, nr) = sweep.right.lanes(i, model);
-        let weighted = (ml * nl + mr * nr).to_array();
-        for (j, &w) in weighted.iter().enumerate() {
-            let b = i + j;
-            let valid = b < nb && sweep.left.count[b] > 0 && sweep.right.count[b] > 0;
-            if valid && w.is_finite() && best.is_none_or(|(bw, _)| w < bw) {
-                best = Some((w, b));
-            }
+        let valid = nl.simd_gt(zero) & nr.simd_gt(zero);
+        let w = valid.select(ml * nl + mr * nr, inf);
+        let better = w.simd_lt(best_w);
+        best_w = better.select(w, best_w);
+        best_i = better.select(index, best_i);
+        index += f32x4::splat(4.0);
+    }
+    let (w, i) = (best_w.to_array(), best_i.to_array());
+    let mut best: Option<(f32, usize)> = None;
+    for lane in 0..4 {
+        let better =
+            best.is_none_or(|(bw, bi)| w[lane] < bw || (w[lane] == bw && (i[lane] as usize) < bi));
+        if w[lane].is_finite() && better {
+            best = Some((w[lane], i[lane] as usize));
         }
     }
     let (weighted, bin) = best?;
@@ -567,18 +581,25 @@ fn partition(arena: &mut BuildArena, task: &Task, split: &Split) -> (Child, Chil
     let axis = split.axis;
     let goes_left =
         |refs: &PrimRefs, i: usize| split.map.bin(refs.centroid2_axis(i, axis)) < split.bin;
-    // Hoare's scheme: only misplaced pairs are swapped. The child centroid bounds are gathered as
-    // each slot settles on its side.
-    let (mut left_c, mut right_c) = (Aabb::EMPTY, Aabb::EMPTY);
+    // Hoare's scheme: only misplaced pairs are swapped. The child centroid bounds are gathered in
+    // 4-wide lanes as each slot settles on its side (lane 3 carries id bits and is dropped).
+    let inf = f32x4::splat(f32::INFINITY);
+    let (mut l_lo, mut l_hi, mut r_lo, mut r_hi) = (inf, -inf, inf, -inf);
+    let c2 = |refs: &PrimRefs, i: usize| {
+        let r = refs.get(i);
+        r.lo4() + r.hi4()
+    };
     let (mut i, mut j) = (task.start as usize, (task.start + task.count) as usize);
     loop {
         while i < j && goes_left(refs, i) {
-            left_c = left_c.grown(refs.centroid2(i));
+            let c = c2(refs, i);
+            (l_lo, l_hi) = (l_lo.fast_min(c), l_hi.fast_max(c));
             i += 1;
         }
         while i < j && !goes_left(refs, j - 1) {
             j -= 1;
-            right_c = right_c.grown(refs.centroid2(j));
+            let c = c2(refs, j);
+            (r_lo, r_hi) = (r_lo.fast_min(c), r_hi.fast_max(c));
         }
         if i >= j {
             break;
@@ -586,14 +607,25 @@ fn partition(arena: &mut BuildArena, task: &Task, split: &Split) -> (Child, Chil
         // Slot i belongs right and slot j - 1 left: swap them into place.
         j -= 1;
         refs.swap(i, j);
-        left_c = left_c.grown(refs.centroid2(i));
-        right_c = right_c.grown(refs.centroid2(j));
+        let (cl, cr) = (c2(refs, i), c2(refs, j));
+        (l_lo, l_hi) = (l_lo.fast_min(cl), l_hi.fast_max(cl));
+        (r_lo, r_hi) = (r_lo.fast_min(cr), r_hi.fast_max(cr));
         i += 1;
     }
     debug_assert_eq!(i as u32 - task.start, split.n_left);
     (
-        (split.left, split.n_left, left_c),
-        (split.right, split.n_right, right_c),
+        (split.left, split.n_left, lanes_to_aabb(l_lo, l_hi)),
+        (split.right, split.n_right, lanes_to_aabb(r_lo, r_hi)),
+    )
+}
+
+/// An [`Aabb`] from `(x, y, z, _)` lanes.
+#[inline(always)]
+fn lanes_to_aabb(lo: f32x4, hi: f32x4) -> Aabb {
+    let (lo, hi) = (lo.to_array(), hi.to_array());
+    Aabb::new(
+        glam::Vec3::new(lo[0], lo[1], lo[2]),
+        glam::Vec3::new(hi[0], hi[1], hi[2]),
     )
 }
 

@@ -9,5 +9,6 @@
 
 pub mod areas;
 pub mod cli;
+pub mod experiment;
 pub mod parallel;
 pub mod scene;

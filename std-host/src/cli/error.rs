@@ -40,6 +40,8 @@ pub enum CliError {
     Stdout(io::Error),
     /// The demo found a BVH answer that differs from brute force: a bug, reported loudly.
     Mismatch(String),
+    /// An experiment or analysis failed.
+    Experiment(crate::experiment::ExperimentError),
 }
 
 impl fmt::Display for CliError {
@@ -56,6 +58,7 @@ impl fmt::Display for CliError {
             }
             CliError::Stdout(e) => write!(f, "cannot write to standard output: {e}"),
             CliError::Mismatch(what) => write!(f, "BVH disagrees with brute force: {what}"),
+            CliError::Experiment(e) => e.fmt(f),
         }
     }
 }
@@ -71,6 +74,7 @@ impl std::error::Error for CliError {
             | CliError::Structure(_)
             | CliError::Usage(_)
             | CliError::Mismatch(_) => None,
+            CliError::Experiment(e) => Some(e),
         }
     }
 }
@@ -115,5 +119,11 @@ impl From<PresetError> for CliError {
             )),
             PresetError::Build(e) => CliError::Build(e),
         }
+    }
+}
+
+impl From<crate::experiment::ExperimentError> for CliError {
+    fn from(e: crate::experiment::ExperimentError) -> Self {
+        CliError::Experiment(e)
     }
 }

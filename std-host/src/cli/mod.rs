@@ -6,11 +6,13 @@
 //! they are kept stable: see each command's documentation. Every failure is one line on standard
 //! error, `error: ...`, and a non-zero exit status: 2 for a bad command line, 1 for anything else.
 
+mod analyze;
 mod areas;
 mod build;
 mod builder;
 mod demo;
 mod error;
+mod experiment;
 mod help;
 mod rays;
 mod structure;
@@ -18,7 +20,9 @@ mod trace;
 
 pub use build::{BuildArgs, BuildReport};
 pub use builder::{chooser_name, BuilderArgs, BuilderKind, BuiltBvh, PresetArg};
+pub use analyze::{AnalyzeArgs, NODE_COLUMNS};
 pub use error::CliError;
+pub use experiment::ExperimentArgs;
 pub use rays::{parse_rays, read_rays, RaysError, OPTIONAL_COLUMNS, REQUIRED_COLUMNS};
 pub use structure::{trace_structure, StructureTrace, DEFAULT_LOCAL_PRESET};
 pub use trace::{trace, Answers, LookupKind, TraceArgs};
@@ -52,6 +56,10 @@ pub enum Command {
     /// one BVH or through the scene structure of influence areas.
     #[command(after_help = help::trace())]
     Trace(TraceArgs),
+    /// Run an experiment file (the thesis's experiments.toml): results.csv, report.md, charts.
+    Experiment(ExperimentArgs),
+    /// Build over each influence area of a scene and print every analyzer metric.
+    Analyze(AnalyzeArgs),
 }
 
 /// Runs the command line `args` (the first item is the program name) and returns the exit
@@ -71,6 +79,8 @@ where
         None => demo::run(&mut out),
         Some(Command::Build(args)) => build::run(args, &mut out),
         Some(Command::Trace(args)) => trace::run(args, &mut io::stderr()),
+        Some(Command::Experiment(args)) => experiment::run(args, &mut out),
+        Some(Command::Analyze(args)) => analyze::run(args, &mut out),
     };
     let result = result.and_then(|()| out.flush().map_err(CliError::Stdout));
     match result {

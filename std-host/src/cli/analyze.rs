@@ -1,0 +1,365 @@
+//! `rdbvh analyze`: every analyzer metric for one build over each influence area of a scene.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use rdbvh_core::analyze::{analyze, containment, NodeRecord, NodeRecords, THESIS_LEVELS};
+use rdbvh_core::build::Preset;
+use rdbvh_core::heuristics::Sah;
+use rdbvh_core::influence::InfluenceArea;
+use rdbvh_core::toplevel::Octree;
+use serde_json::{json, Value};
+
+use super::areas::load_areas;
+use super::{load_scene, CliError};
+use crate::experiment::{build_fallback, run_one, sample_rays, RunMetrics, RunSetup, Settings};
+
+/// The per-node columns `--nodes FILE.csv` can write.
+pub const NODE_COLUMNS: [&str; 15] = [
+    "index",
+    "parent",
+    "depth",
+    "min_x",
+    "min_y",
+    "min_z",
+    "max_x",
+    "max_y",
+    "max_z",
+    "count",
+    "left_first",
+    "measure",
+    "hit_probability",
+    "is_leaf",
+    "area",
+];
+
+/// Arguments of `rdbvh analyze`.
+#[derive(Args, Debug, Clone)]
+pub struct AnalyzeArgs {
+    /// The scene: an OBJ file, or builtin:NAME.
+    #[arg(value_name = "SCENE.obj")]
+    pub scene: String,
+    /// Influence areas (TOML): one build and analysis per area that applies to the scene.
+    #[arg(long, value_name = "AREAS.toml")]
+    pub areas: PathBuf,
+    /// The local BVH's preset: full, longest, facing, standard or sah.
+    #[arg(long, value_name = "NAME", default_value = "full")]
+    pub preset: String,
+    /// Rays traced per area for the measured costs.
+    #[arg(long, value_name = "N", default_value_t = 1000, value_parser = clap::value_parser!(u32).range(1..))]
+    pub rays: u32,
+    /// The thesis's builder, constants, fallback and ray sampler (as `experiment --thesis-mode`).
+    #[arg(long)]
+    pub thesis_mode: bool,
+    /// Print one JSON object instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Export the first area's local BVH per node: JSON (whole tree) for a `.json` file, CSV
+    /// otherwise.
+    #[arg(long, value_name = "FILE")]
+    pub nodes: Option<PathBuf>,
+    /// CSV columns for --nodes, comma-separated (default: all of index, parent, depth, min_x,
+    /// min_y, min_z, max_x, max_y, max_z, count, left_first, measure, hit_probability, is_leaf,
+    /// area).
+    #[arg(long, value_name = "a,b", value_delimiter = ',')]
+    pub columns: Option<Vec<String>>,
+}
+
+fn setup(args: &AnalyzeArgs) -> RunSetup {
+    use rdbvh_core::build::PresetOptions;
+    use rdbvh_core::influence::PointDistribution;
+    let s = Settings {
+        rays_per_config: args.rays,
+        ..Settings::default()
+    };
+    let local = s.preset_options(args.thesis_mode);
+    RunSetup {
+        local,
+        fallback: if args.thesis_mode {
+            local
+        } else {
+            PresetOptions::default()
+        },
+        fallback_preset: if args.thesis_mode {
+            Preset::Standard
+        } else {
+            Preset::Sah
+        },
+        constants: s.constants(args.thesis_mode),
+        rays: args.rays,
+        octree_levels: s.octree_levels,
+        point_distribution: if args.thesis_mode {
+            PointDistribution::YawPitch
+        } else {
+            PointDistribution::SolidAngle
+        },
+    }
+}
+
+fn levels_json(v: &[f32]) -> Value {
+    Value::Object(
+        THESIS_LEVELS
+            .iter()
+            .zip(v)
+            .map(|(l, x)| (l.to_string(), json!(x)))
+            .collect(),
+    )
+}
+
+fn metrics_json(area: usize, kind: &str, m: &RunMetrics, error: f32) -> Value {
+    let c = &m.costs;
+    let mut o = serde_json::Map::new();
+    let mut put = |k: &str, v: Value| {
+        o.insert(k.to_string(), v);
+    };
+    put("area", json!(area));
+    put("kind", json!(kind));
+    put("local_triangles", json!(m.local_triangles));
+    put("build_ms", json!(m.build_ms));
+    put("nodes", json!(m.shape.nodes));
+    put("inner_nodes", json!(m.shape.inner));
+    put("leaves", json!(m.shape.leaves));
+    put("max_depth", json!(m.shape.max_depth));
+    put("levels", json!(m.shape.levels()));
+    put("mean_leaf_depth", json!(m.shape.mean_leaf_depth));
+    put("leaf_sizes", json!(m.shape.leaf_sizes));
+    put("sah_cost", json!(m.sah));
+    put("pah_cost", json!(m.pah));
+    put("pah_cost_relative_to_root", json!(m.pah_root));
+    put("epo", json!(m.epo));
+    put("overlap_3d", json!(levels_json(&m.overlap_3d)));
+    put(
+        "overlap_projected",
+        json!(levels_json(&m.overlap_projected)),
+    );
+    put("overlap_culled", json!(levels_json(&m.overlap_culled)));
+    put("rays", json!(c.rays));
+    put("all_hit_cost_with_fallback", json!(c.all_hit_structure));
+    put("all_hit_cost_without_fallback", json!(c.all_hit_local));
+    put(
+        "all_hit_cost_fallback_part_when_fell_back",
+        json!(c.all_hit_fallback_when_fell_back),
+    );
+    put(
+        "all_hit_cost_fallback_alone",
+        json!(c.all_hit_fallback_alone),
+    );
+    put(
+        "intersections_with_fallback",
+        json!(c.intersections_structure),
+    );
+    put(
+        "intersections_without_fallback",
+        json!(c.intersections_local),
+    );
+    put("local_hit_rate", json!(c.local_hit_rate));
+    put(
+        "closest_hit_cost_with_fallback",
+        json!(c.closest_hit_structure),
+    );
+    put(
+        "closest_hit_cost_without_fallback",
+        json!(c.closest_hit_local),
+    );
+    put(
+        "closest_hit_cost_fallback_alone",
+        json!(c.closest_hit_fallback_alone),
+    );
+    put("closest_hit_local_rate", json!(c.closest_hit_local_rate));
+    put("any_hit_cost_with_fallback", json!(c.any_hit_structure));
+    put(
+        "any_hit_cost_fallback_alone",
+        json!(c.any_hit_fallback_alone),
+    );
+    put("rays_per_second", json!(m.rays_per_second));
+    put(
+        "rays_per_second_fallback_alone",
+        json!(m.rays_per_second_fallback),
+    );
+    put("local_bvh_bytes", json!(m.shape.memory_bytes));
+    put("fallback_bvh_bytes", json!(m.fallback_bytes));
+    put("fallback_sah_cost", json!(m.fallback_sah));
+    put("octree_levels", json!(m.octree.levels));
+    put("octree_leaves", json!(m.octree.leaves));
+    put("octree_bytes", json!(m.octree.bytes));
+    put("octree_containment_error", json!(error));
+    put("area_bytes", json!(m.area_bytes));
+    Value::Object(o)
+}
+
+fn node_field(r: &NodeRecord, col: &str) -> String {
+    match col {
+        "index" => r.index.to_string(),
+        "parent" => {
+            if r.parent == u32::MAX {
+                String::new()
+            } else {
+                r.parent.to_string()
+            }
+        }
+        "depth" => r.depth.to_string(),
+        "min_x" => r.min[0].to_string(),
+        "min_y" => r.min[1].to_string(),
+        "min_z" => r.min[2].to_string(),
+        "max_x" => r.max[0].to_string(),
+        "max_y" => r.max[1].to_string(),
+        "max_z" => r.max[2].to_string(),
+        "count" => r.count.to_string(),
+        "left_first" => r.left_first.to_string(),
+        "measure" => r.measure.to_string(),
+        "hit_probability" => r.hit_probability.to_string(),
+        "is_leaf" => (r.count > 0).to_string(),
+        _ => String::new(),
+    }
+}
+
+fn write_nodes(
+    path: &Path,
+    records: &[NodeRecord],
+    columns: Option<&[String]>,
+) -> Result<(), CliError> {
+    let fail = |e: std::io::Error| CliError::Write {
+        path: path.to_path_buf(),
+        source: e,
+    };
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+    {
+        let nodes: Vec<Value> = records
+            .iter()
+            .map(|r| {
+                json!({
+                    "index": r.index,
+                    "parent": (r.parent != u32::MAX).then_some(r.parent),
+                    "depth": r.depth, "min": r.min, "max": r.max, "count": r.count,
+                    "left_first": r.left_first, "sah_measure": r.measure,
+                    "hit_probability": r.hit_probability,
+                })
+            })
+            .collect();
+        let text = serde_json::to_string(&json!({ "nodes": nodes }))
+            .map_err(|e| fail(std::io::Error::other(e)))?;
+        return std::fs::write(path, text).map_err(fail);
+    }
+    let cols: Vec<String> = match columns {
+        Some(c) => c.iter().map(|s| s.trim().to_string()).collect(),
+        None => NODE_COLUMNS.iter().map(|s| s.to_string()).collect(),
+    };
+    if let Some(bad) = cols.iter().find(|c| !NODE_COLUMNS.contains(&c.as_str())) {
+        return Err(CliError::Usage(format!(
+            "unknown node column `{bad}` (expected {})",
+            NODE_COLUMNS.join(", ")
+        )));
+    }
+    let mut text = cols.join(",");
+    text.push('\n');
+    for r in records {
+        let row: Vec<String> = cols
+            .iter()
+            .map(|c| {
+                if c == "area" {
+                    let e = glam::Vec3::from(r.max) - glam::Vec3::from(r.min);
+                    (2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)).to_string()
+                } else {
+                    node_field(r, c)
+                }
+            })
+            .collect();
+        text.push_str(&row.join(","));
+        text.push('\n');
+    }
+    std::fs::write(path, text).map_err(fail)
+}
+
+/// Builds and analyses; prints a table (or JSON) to `out`.
+pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let preset = Preset::from_name(&args.preset).ok_or_else(|| {
+        CliError::Usage(format!(
+            "unknown preset `{}` (expected full, longest, facing, standard or sah)",
+            args.preset
+        ))
+    })?;
+    let (scene, _) = load_scene(&args.scene)?;
+    let entries = load_areas(&args.areas, &scene)?;
+    let setup = setup(args);
+    let fallback = build_fallback(&scene.triangles, &setup)?;
+    let mut reports = Vec::new();
+    for (i, entry) in entries.iter().enumerate() {
+        let rays = sample_rays(&entry.area, &setup, entry.index as u64 + 1);
+        let m = run_one(
+            &scene.triangles,
+            &entry.area,
+            preset,
+            &fallback,
+            &rays,
+            &setup,
+        )?;
+        let octree = Octree::build(&[entry.area], setup.octree_levels);
+        let c = containment(&octree, &[entry.area], &entry.area.bounds(), 20_000, 1);
+        let kind = match entry.area {
+            InfluenceArea::Plane(_) => "plane",
+            InfluenceArea::Point(_) => "point",
+        };
+        if i == 0 {
+            if let Some(path) = &args.nodes {
+                // The same build again, for its per-node records.
+                let ids: Vec<u32> = rdbvh_core::toplevel::Scene::<Octree>::triangles_in_area(
+                    &entry.area,
+                    &scene.triangles,
+                )
+                .collect();
+                let mut arena = rdbvh_core::build::BuildArena::with_capacity(ids.len());
+                arena.load_triangle_subset(&scene.triangles, ids)?;
+                let mut bvh = rdbvh_core::bvh::Bvh::with_capacity(arena.len());
+                preset
+                    .build_into(Some(&entry.area), &setup.local, &mut arena, &mut bvh)
+                    .map_err(|e| CliError::Usage(e.to_string()))?;
+                let records = analyze(&bvh, NodeRecords::new(Sah));
+                write_nodes(path, &records, args.columns.as_deref())?;
+            }
+        }
+        reports.push(metrics_json(entry.index + 1, kind, &m, c.error()));
+    }
+    let doc = json!({
+        "scene": scene.name,
+        "triangles": scene.triangles.len(),
+        "preset": preset.name(),
+        "mode": if args.thesis_mode { "thesis" } else { "project" },
+        "areas": reports,
+    });
+    let w = CliError::Stdout;
+    if args.json {
+        writeln!(out, "{doc}").map_err(w)?;
+        return Ok(());
+    }
+    writeln!(
+        out,
+        "{}: {} triangles, preset {}, {} mode",
+        scene.name,
+        scene.triangles.len(),
+        preset.name(),
+        if args.thesis_mode {
+            "thesis"
+        } else {
+            "project"
+        }
+    )
+    .map_err(w)?;
+    for r in &reports {
+        writeln!(
+            out,
+            "area {} ({}):",
+            r["area"],
+            r["kind"].as_str().unwrap_or("")
+        )
+        .map_err(w)?;
+        if let Some(obj) = r.as_object() {
+            for (k, v) in obj.iter().filter(|(k, _)| *k != "area" && *k != "kind") {
+                writeln!(out, "  {k:<44} {v}").map_err(w)?;
+            }
+        }
+    }
+    Ok(())
+}

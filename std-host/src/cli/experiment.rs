@@ -1,0 +1,105 @@
+//! `rdbvh experiment`: run an experiment file (such as the thesis's `experiments.toml`).
+
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::CliError;
+use crate::experiment::{
+    cheaper_groups, parse_presets, run_experiment, ExperimentOptions, Overrides,
+};
+
+/// Arguments of `rdbvh experiment`.
+#[derive(Args, Debug, Clone)]
+#[command(after_help = "\
+Runs every [[config]] of FILE.toml that has a scene file (found under scene_dir, relative to
+FILE.toml) with every heuristic of [settings].heuristics, in parallel, and writes DIR/results.csv
+(one row per run, the thesis's columns first), DIR/report.md and charts (SVG and PNG).
+Every [settings] key is optional; rays_per_config and heuristics apply in every mode, the builder
+keys (candidate_planes, max_triangles_per_leaf, inner_node_cost, triangle_cost, thresholds) only
+with --thesis-mode. Charts have text when a TTF font is found (RDBVH_FONT=path, or DejaVu Sans).")]
+pub struct ExperimentArgs {
+    /// The experiment file.
+    #[arg(value_name = "FILE.toml")]
+    pub file: PathBuf,
+    /// Output folder (created if missing).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Reproduce the thesis's builder: the file's candidate planes over the node box, leaf size,
+    /// cost constants and thresholds, an SAH + LSPH fallback, yaw/pitch point rays.
+    #[arg(long)]
+    pub thesis_mode: bool,
+    /// Rays per run (overrides rays_per_config).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub rays: Option<u32>,
+    /// Heuristics to run, comma-separated: full, longest, facing, standard, sah (overrides
+    /// heuristics).
+    #[arg(long, value_name = "a,b", value_delimiter = ',')]
+    pub presets: Option<Vec<String>>,
+    /// The thesis's results folder (its Plane_*.csv and Point_*.csv): shown beside ours.
+    #[arg(long, value_name = "DIR")]
+    pub thesis_results: Option<PathBuf>,
+    /// Candidate planes per axis in thesis mode (overrides candidate_planes).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=255))]
+    pub candidate_planes: Option<u32>,
+    /// Largest leaf in thesis mode (overrides max_triangles_per_leaf).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub max_leaf: Option<u32>,
+    /// Octree levels (overrides octree_levels).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10))]
+    pub octree_levels: Option<u32>,
+}
+
+/// Runs the experiment and prints a short summary to `out`.
+pub fn run(args: &ExperimentArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let presets = match &args.presets {
+        Some(names) => Some(
+            parse_presets(names.iter().map(String::as_str))
+                .map_err(|e| CliError::Usage(e.to_string()))?,
+        ),
+        None => None,
+    };
+    let opts = ExperimentOptions {
+        file: args.file.clone(),
+        out: args.out.clone(),
+        thesis_mode: args.thesis_mode,
+        thesis_results: args.thesis_results.clone(),
+        overrides: Overrides {
+            rays: args.rays,
+            presets,
+            candidate_planes: args.candidate_planes,
+            max_leaf: args.max_leaf,
+            octree_levels: args.octree_levels,
+        },
+        progress: std::io::stderr().is_terminal(),
+    };
+    let s = run_experiment(&opts, &mut std::io::stderr())?;
+    let w = |e| CliError::Stdout(e);
+    writeln!(
+        out,
+        "{} runs in {:.1} s -> {}",
+        s.rows.len(),
+        s.seconds,
+        args.out.join("results.csv").display()
+    )
+    .map_err(w)?;
+    let pct = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{:.1}%", 100.0 * v));
+    writeln!(
+        out,
+        "PAH estimate error: plane {} point {}; SAH: plane {} point {}",
+        pct(s.ours.pah_error_by_kind[0]),
+        pct(s.ours.pah_error_by_kind[1]),
+        pct(s.ours.sah_error_by_kind[0]),
+        pct(s.ours.sah_error_by_kind[1]),
+    )
+    .map_err(w)?;
+    let (c, n) = cheaper_groups(&s.ours.structure_over_fallback);
+    writeln!(
+        out,
+        "full structure cheaper than the fallback BVH alone in {c} of {n} groups; report: {}",
+        args.out.join("report.md").display()
+    )
+    .map_err(w)?;
+    Ok(())
+}

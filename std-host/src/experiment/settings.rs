@@ -1,0 +1,217 @@
+//! The experiment file: `scene_dir`, `[settings]` and the `[[config]]` entries.
+
+use std::path::{Path, PathBuf};
+
+use rdbvh_core::build::{Preset, PresetOptions, ThesisCut};
+use rdbvh_core::heuristics::CostConstants;
+use serde::Deserialize;
+
+use super::ExperimentError;
+use crate::areas::{parse_areas, AreaEntry};
+
+/// `[settings]`: every key is optional. `rays_per_config` and `heuristics` apply in every mode;
+/// the builder keys apply only with `--thesis-mode` (without it the project's binned builder runs
+/// with its own defaults, see [`PresetOptions::default`]).
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct Settings {
+    /// Rays traced per run (default 1000, the thesis's).
+    pub rays_per_config: u32,
+    /// Presets run on every configuration (default the thesis's four: full, longest, facing,
+    /// standard).
+    pub heuristics: Vec<String>,
+    /// Candidate split planes per axis, uniformly over the node box (thesis mode; default 40).
+    pub candidate_planes: u32,
+    /// Largest leaf (thesis mode; default 2).
+    pub max_triangles_per_leaf: u32,
+    /// The thesis's depth limit (default 100). This project's builders bound depth at 64
+    /// (`rdbvh_core::bvh::MAX_DEPTH`); the value is reported, not used.
+    pub max_levels: u32,
+    /// Octree levels of the top-level structure (every mode; default 5).
+    pub octree_levels: u32,
+    /// Cost per visited inner node, counted twice (thesis mode; default 1.0).
+    pub inner_node_cost: f32,
+    /// Cost per triangle test (thesis mode; default 1.2).
+    pub triangle_cost: f32,
+    /// SPFH's cut-evaluation quality threshold (thesis mode; default 0.4).
+    pub spfh_quality_threshold: f32,
+    /// LSPH's quality threshold (thesis mode; default 0.99).
+    pub lsph_quality_threshold: f32,
+    /// Acceptable `(P_left + P_right) / P_parent` (thesis mode; default 1.3).
+    pub acceptable_ratio: f32,
+    /// Excellent ratio (thesis mode; default 0.9).
+    pub excellent_ratio: f32,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            rays_per_config: 1000,
+            heuristics: ["full", "longest", "facing", "standard"]
+                .map(String::from)
+                .to_vec(),
+            candidate_planes: 40,
+            max_triangles_per_leaf: 2,
+            max_levels: 100,
+            octree_levels: 5,
+            inner_node_cost: 1.0,
+            triangle_cost: 1.2,
+            spfh_quality_threshold: 0.4,
+            lsph_quality_threshold: 0.99,
+            acceptable_ratio: 1.3,
+            excellent_ratio: 0.9,
+        }
+    }
+}
+
+impl Settings {
+    /// The builder options for the local BVHs: the file's builder keys in thesis mode, the
+    /// project's defaults otherwise.
+    pub fn preset_options(&self, thesis_mode: bool) -> PresetOptions {
+        if !thesis_mode {
+            return PresetOptions::default();
+        }
+        PresetOptions {
+            bins: self.candidate_planes.saturating_add(1),
+            max_leaf: self.max_triangles_per_leaf,
+            constants: self.constants(true),
+            cut: ThesisCut {
+                excellent_ratio: self.excellent_ratio,
+                acceptable_ratio: self.acceptable_ratio,
+                quality_threshold: self.spfh_quality_threshold,
+            },
+            lsph_quality_threshold: self.lsph_quality_threshold,
+            ..PresetOptions::thesis()
+        }
+    }
+
+    /// The cost constants of estimates and measurements: the file's in thesis mode (an inner node
+    /// counted twice), `C_trav = C_isect = 1` otherwise.
+    pub fn constants(&self, thesis_mode: bool) -> CostConstants {
+        if thesis_mode {
+            CostConstants {
+                traversal: 2.0 * self.inner_node_cost,
+                intersection: self.triangle_cost,
+            }
+        } else {
+            CostConstants::default()
+        }
+    }
+
+    /// The presets named in `heuristics`, checked.
+    pub fn presets(&self) -> Result<Vec<Preset>, ExperimentError> {
+        parse_presets(self.heuristics.iter().map(String::as_str))
+    }
+}
+
+/// Presets from their names (`full`, `longest`, `facing`, `standard`, `sah`), without repeats.
+pub fn parse_presets<'a>(
+    names: impl IntoIterator<Item = &'a str>,
+) -> Result<Vec<Preset>, ExperimentError> {
+    let mut out = Vec::new();
+    for name in names {
+        let name = name.trim();
+        let p = Preset::from_name(name).ok_or_else(|| {
+            ExperimentError::Settings(format!(
+                "unknown heuristic `{name}` (expected full, longest, facing, standard or sah)"
+            ))
+        })?;
+        if !out.contains(&p) {
+            out.push(p);
+        }
+    }
+    if out.is_empty() {
+        return Err(ExperimentError::Settings("no heuristic to run".into()));
+    }
+    Ok(out)
+}
+
+#[derive(Deserialize)]
+struct Top {
+    #[serde(default)]
+    scene_dir: Option<String>,
+    #[serde(default)]
+    settings: Settings,
+}
+
+/// A parsed experiment file.
+#[derive(Clone, Debug)]
+pub struct ExperimentFile {
+    /// Where it was read from.
+    pub path: PathBuf,
+    /// Where scene files are found: `scene_dir` relative to the file's folder (default: the
+    /// file's folder).
+    pub scene_dir: PathBuf,
+    /// `[settings]`.
+    pub settings: Settings,
+    /// The `[[config]]` entries, in file order.
+    pub configs: Vec<AreaEntry>,
+}
+
+impl ExperimentFile {
+    /// Reads and checks an experiment file.
+    pub fn read(path: &Path) -> Result<Self, ExperimentError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| ExperimentError::Io(path.to_path_buf(), e.to_string()))?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses an experiment file's text; `path` locates `scene_dir` and labels errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, ExperimentError> {
+        let top: Top = toml::from_str(text).map_err(|e| {
+            ExperimentError::Settings(format!(
+                "{}: {}",
+                path.display(),
+                e.message().lines().next().unwrap_or("invalid TOML")
+            ))
+        })?;
+        let areas = parse_areas(text, path).map_err(|e| ExperimentError::Areas(e.to_string()))?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        let scene_dir = match top.scene_dir {
+            Some(d) => base.join(d),
+            None => base.to_path_buf(),
+        };
+        Ok(Self {
+            path: path.to_path_buf(),
+            scene_dir,
+            settings: top.settings,
+            configs: areas.entries,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_key_is_optional_and_unknown_ones_are_errors() {
+        let text = "[[config]]\nkind = \"plane\"\ncenter = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\nhalf_width = 1.0\nhalf_height = 1.0\ndepth = 1.0\n";
+        let f = ExperimentFile::parse(text, Path::new("/x/e.toml")).unwrap();
+        assert_eq!(f.settings, Settings::default());
+        assert_eq!(f.scene_dir, Path::new("/x"));
+        assert_eq!(f.configs.len(), 1);
+        let bad = format!("[settings]\nrays_per_confg = 3\n{text}");
+        let e = ExperimentFile::parse(&bad, Path::new("e.toml")).unwrap_err();
+        assert!(e.to_string().contains("rays_per_confg"), "{e}");
+        assert!(parse_presets(["full", "bogus"]).is_err());
+        assert_eq!(
+            parse_presets(["Full", "full", "standard"]).unwrap(),
+            vec![Preset::Full, Preset::Standard]
+        );
+    }
+
+    #[test]
+    fn thesis_mode_takes_the_files_builder_values() {
+        let s = Settings {
+            candidate_planes: 10,
+            inner_node_cost: 0.5,
+            ..Settings::default()
+        };
+        let o = s.preset_options(true);
+        assert_eq!(o.bins, 11);
+        assert!(o.thesis_mode);
+        assert_eq!(s.constants(true).traversal, 1.0);
+        assert_eq!(s.preset_options(false), PresetOptions::default());
+    }
+}

@@ -1,0 +1,209 @@
+//! The thesis's findings, computed the same way from any result table (ours or the thesis's):
+//! estimate error, SPFH vs LSPH, and the full structure vs the fallback BVH, per orientation group.
+
+use std::collections::HashMap;
+
+use super::results::Table;
+
+/// The eight orientation groups, in chart order.
+pub const GROUPS: [(&str, &str); 8] = [
+    ("Plane", "Parallel"),
+    ("Plane", "15"),
+    ("Plane", "45"),
+    ("Plane", "Oblique"),
+    ("Point", "Parallel"),
+    ("Point", "15"),
+    ("Point", "45"),
+    ("Point", "Oblique"),
+];
+
+/// What identifies a run beside its name.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RunKey {
+    /// The row name.
+    pub name: String,
+    /// Scene.
+    pub scene: String,
+    /// `Plane` or `Point`.
+    pub kind: String,
+    /// `Parallel`, `15`, `45`, `Oblique`.
+    pub orientation: String,
+    /// `Full`, `Longest`, `Facing`, `Standard` (or `Sah`).
+    pub heuristic: String,
+}
+
+/// One number per group (`None` where the table has no run of that group).
+pub type PerGroup = [Option<f64>; 8];
+
+/// The findings of one table.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Findings {
+    /// Mean |PAH estimate - real cost without fallback| / real cost, over every run of the group.
+    pub pah_error: PerGroup,
+    /// The same for the SAH estimate.
+    pub sah_error: PerGroup,
+    /// Mean over scenes of `facing / standard` real cost without fallback (SPFH vs LSPH, both
+    /// with SAH: the thesis's Figure 10).
+    pub spfh_over_lsph: PerGroup,
+    /// Mean over scenes of `full / longest` (SPFH vs LSPH, both with PAH).
+    pub spfh_over_lsph_pah: PerGroup,
+    /// For the `full` preset: summed real cost with fallback over summed fallback-BVH-alone cost.
+    pub structure_over_fallback: PerGroup,
+    /// The same with closest-hit costs (this project's columns only).
+    pub structure_over_fallback_closest: PerGroup,
+    /// Mean PAH error over all plane runs and over all point runs.
+    pub pah_error_by_kind: [Option<f64>; 2],
+    /// Mean SAH error over all plane runs and over all point runs.
+    pub sah_error_by_kind: [Option<f64>; 2],
+}
+
+fn mean(v: &[f64]) -> Option<f64> {
+    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+}
+
+fn col(row: &HashMap<String, f64>, c: &str) -> Option<f64> {
+    row.get(c).copied().filter(|x| x.is_finite())
+}
+
+fn rel_error(row: &HashMap<String, f64>, estimate: &str) -> Option<f64> {
+    let real = col(row, "Real cost without fallback")?;
+    let est = col(row, estimate)?;
+    (real > 0.0).then(|| (est - real).abs() / real)
+}
+
+/// Computes the findings of `table` over the runs `keys` (runs missing from the table are
+/// skipped, so the thesis's numbers are taken over the same runs as ours).
+pub fn findings(table: &Table, keys: &[RunKey]) -> Findings {
+    let mut out = Findings::default();
+    let row = |name: &str| table.get(name);
+    for (g, &(kind, orient)) in GROUPS.iter().enumerate() {
+        let in_group: Vec<&RunKey> = keys
+            .iter()
+            .filter(|k| k.kind == kind && k.orientation == orient)
+            .collect();
+        let errors = |est: &str| -> Vec<f64> {
+            in_group
+                .iter()
+                .filter_map(|k| row(&k.name).and_then(|r| rel_error(r, est)))
+                .collect()
+        };
+        out.pah_error[g] = mean(&errors("Estimated PAH cost"));
+        out.sah_error[g] = mean(&errors("Estimated SAH cost"));
+        let ratio = |num: &str, den: &str, column: &str| -> Vec<f64> {
+            let mut v = Vec::new();
+            for k in in_group.iter().filter(|k| k.heuristic == num) {
+                let Some(other) = in_group
+                    .iter()
+                    .find(|o| o.scene == k.scene && o.heuristic == den)
+                else {
+                    continue;
+                };
+                if let (Some(a), Some(b)) = (
+                    row(&k.name).and_then(|r| col(r, column)),
+                    row(&other.name).and_then(|r| col(r, column)),
+                ) {
+                    if b > 0.0 {
+                        v.push(a / b);
+                    }
+                }
+            }
+            v
+        };
+        out.spfh_over_lsph[g] = mean(&ratio("Facing", "Standard", "Real cost without fallback"));
+        out.spfh_over_lsph_pah[g] = mean(&ratio("Full", "Longest", "Real cost without fallback"));
+        let sums = |a: &str, b: &str| -> Option<f64> {
+            let (mut x, mut y, mut n) = (0.0, 0.0, 0);
+            for k in in_group.iter().filter(|k| k.heuristic == "Full") {
+                if let Some(r) = row(&k.name) {
+                    if let (Some(p), Some(q)) = (col(r, a), col(r, b)) {
+                        x += p;
+                        y += q;
+                        n += 1;
+                    }
+                }
+            }
+            (n > 0 && y > 0.0).then(|| x / y)
+        };
+        out.structure_over_fallback[g] = sums("Real cost with fallback", "Fallback BVH cost");
+        out.structure_over_fallback_closest[g] = sums(
+            "Closest-hit cost with fallback",
+            "Closest-hit cost fallback BVH alone",
+        );
+    }
+    for (i, kind) in ["Plane", "Point"].iter().enumerate() {
+        let errs = |est: &str| -> Vec<f64> {
+            keys.iter()
+                .filter(|k| k.kind == *kind)
+                .filter_map(|k| row(&k.name).and_then(|r| rel_error(r, est)))
+                .collect()
+        };
+        out.pah_error_by_kind[i] = mean(&errs("Estimated PAH cost"));
+        out.sah_error_by_kind[i] = mean(&errs("Estimated SAH cost"));
+    }
+    out
+}
+
+/// How many groups have a ratio below 1 (the structure cheaper than the fallback alone), out of
+/// how many have one.
+pub fn cheaper_groups(v: &PerGroup) -> (usize, usize) {
+    let known: Vec<f64> = v.iter().flatten().copied().collect();
+    (known.iter().filter(|&&x| x < 1.0).count(), known.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key(scene: &str, h: &str) -> RunKey {
+        RunKey {
+            name: format!("{scene}_Plane_Parallel_{h}"),
+            scene: scene.into(),
+            kind: "Plane".into(),
+            orientation: "Parallel".into(),
+            heuristic: h.into(),
+        }
+    }
+
+    #[test]
+    fn findings_by_hand() {
+        let mut t = Table::new();
+        let put = |t: &mut Table, k: &RunKey, vals: &[(&str, f64)]| {
+            t.insert(
+                k.name.clone(),
+                vals.iter().map(|(c, v)| (c.to_string(), *v)).collect(),
+            );
+        };
+        let (f, s, full) = (key("A", "Facing"), key("A", "Standard"), key("A", "Full"));
+        put(
+            &mut t,
+            &f,
+            &[
+                ("Real cost without fallback", 8.0),
+                ("Estimated PAH cost", 9.0),
+                ("Estimated SAH cost", 4.0),
+            ],
+        );
+        put(
+            &mut t,
+            &s,
+            &[
+                ("Real cost without fallback", 10.0),
+                ("Estimated PAH cost", 10.0),
+                ("Estimated SAH cost", 5.0),
+            ],
+        );
+        put(
+            &mut t,
+            &full,
+            &[("Real cost with fallback", 3.0), ("Fallback BVH cost", 4.0)],
+        );
+        let r = findings(&t, &[f, s, full]);
+        // PAH errors 1/8 and 0 -> 1/16; SAH errors 4/8 and 5/10 -> 0.5.
+        assert!((r.pah_error[0].unwrap() - 0.0625).abs() < 1e-12);
+        assert!((r.sah_error[0].unwrap() - 0.5).abs() < 1e-12);
+        assert!((r.spfh_over_lsph[0].unwrap() - 0.8).abs() < 1e-12);
+        assert!((r.structure_over_fallback[0].unwrap() - 0.75).abs() < 1e-12);
+        assert_eq!(r.pah_error[1], None);
+        assert_eq!(cheaper_groups(&r.structure_over_fallback), (1, 1));
+    }
+}

@@ -35,3 +35,5 @@ impl fmt::Display for BuildError {
         }
     }
 }
+
+impl core::error::Error for BuildError {}

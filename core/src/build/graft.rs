@@ -27,6 +27,8 @@ impl core::fmt::Display for GraftError {
     }
 }
 
+impl core::error::Error for GraftError {}
+
 impl Bvh {
     /// Replaces each job's placeholder leaf in `top` (from [`super::Builder::build_top`]) with the
     /// subtree built for it (with [`super::Builder::build_subtree_into`] over the job's slots, in

@@ -166,12 +166,14 @@ impl fmt::Display for PresetError {
         match self {
             PresetError::NeedsArea(p) => write!(
                 f,
-                "preset `{p}` uses PAH or SPFH and needs an influence area (give --areas)"
+                "preset `{p}` uses PAH or SPFH and needs an influence area"
             ),
             PresetError::Build(e) => e.fmt(f),
         }
     }
 }
+
+impl core::error::Error for PresetError {}
 
 impl From<BuildError> for PresetError {
     fn from(e: BuildError) -> Self {

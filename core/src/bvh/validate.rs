@@ -67,6 +67,8 @@ impl fmt::Display for InvariantError {
     }
 }
 
+impl core::error::Error for InvariantError {}
+
 impl Bvh {
     /// Checks every invariant for a BVH built over primitive ids `0..prim_count` whose boxes
     /// `prim_bounds(id)` returns: each id in exactly one leaf, children in range and reached once,

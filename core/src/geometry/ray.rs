@@ -30,6 +30,8 @@ impl fmt::Display for RayError {
     }
 }
 
+impl core::error::Error for RayError {}
+
 /// A ray segment. `t` is measured in units of `dir`, which is not normalised: hit distances are
 /// parametric, as a renderer that passes a light sample's unnormalised direction with `t_max = 1`
 /// expects. A segment with `t_min > t_max` is empty and hits nothing.

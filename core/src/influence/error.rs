@@ -37,6 +37,8 @@ impl fmt::Display for AreaError {
     }
 }
 
+impl core::error::Error for AreaError {}
+
 /// Checks that every component is finite.
 pub(crate) fn finite3(v: glam::Vec3, key: &'static str) -> Result<glam::Vec3, AreaError> {
     v.is_finite().then_some(v).ok_or(AreaError::NotFinite(key))

@@ -62,6 +62,8 @@ impl fmt::Display for SceneError {
     }
 }
 
+impl core::error::Error for SceneError {}
+
 /// What one query through the scene did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SceneStats {

@@ -237,8 +237,8 @@ impl<L: AreaLookup> Scene<L> {
             + self.areas.len() * core::mem::size_of::<InfluenceArea>()
     }
 
-    /// The local segments to search: for each of up to `max_tries` affine candidate areas whose
-    /// part of the segment starts at `t_min` (the origin is inside), the area and its exit.
+    /// The local segments to search: for each of up to `max_tries` affine candidate areas (the
+    /// origin is inside), the area and where the segment leaves it.
     #[inline]
     fn affine_segments<'a>(&'a self, ray: &'a Ray) -> impl Iterator<Item = (u32, f32)> + 'a {
         self.lookup
@@ -249,8 +249,13 @@ impl<L: AreaLookup> Scene<L> {
                 if !area.is_affine(ray) {
                     return None;
                 }
-                let (t0, t1) = area.polytope().clip_ray(ray)?;
-                (t0 <= ray.t_min).then_some((a, t1))
+                // The origin is inside up to the containment tolerance, so even when rounding
+                // puts the clipped entry a hair past `t_min` (rays starting on the light's
+                // rectangle or the near plane), the segment before it stays within that
+                // tolerance of the area, where the conservative SAT selection has every
+                // triangle: the local BVH answers from `t_min`.
+                let (_, t1) = area.polytope().clip_ray(ray)?;
+                Some((a, t1))
             })
             .take(self.max_tries as usize)
     }

@@ -9,7 +9,7 @@
 
 use rayon::prelude::*;
 
-use rdbvh_core::build::{BuildArena, Builder, Preset, PresetError, Subtree};
+use rdbvh_core::build::{BuildArena, Builder, PresetError, Subtree};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::heuristics::{AxisChooser, CostModel, Termination};
@@ -115,7 +115,8 @@ pub fn build_scene<L: AreaLookup>(
             .load_triangles(tris)
             .map_err(|e| SceneError::Fallback(e.into()))?;
         let mut bvh = Bvh::with_capacity(tris.len());
-        Preset::Sah
+        options
+            .fallback_preset
             .build_into(None, &options.fallback, &mut arena, &mut bvh)
             .map_err(SceneError::Fallback)?;
         Ok::<_, SceneError>(bvh)

@@ -6,7 +6,9 @@ use alloc::vec::Vec;
 use glam::{Vec2, Vec3};
 
 use crate::bvh::Bvh;
-use crate::geometry::{Aabb, ConvexPolygon, Frame, MAX_POLY};
+use crate::geometry::{
+    orthographic_silhouette, perspective_silhouette, Aabb, ConvexPolygon, Frame, MAX_POLY,
+};
 use crate::influence::InfluenceArea;
 
 use super::{Analysis, NodeView};
@@ -88,11 +90,7 @@ impl OverlapSpace {
             }
             OverlapSpace::Ortho { right, up, window } => {
                 let project = |x: &Aabb| {
-                    let pts: [Vec2; 8] = core::array::from_fn(|i| {
-                        let p = corner(x, i);
-                        Vec2::new(p.dot(right), p.dot(up))
-                    });
-                    let hull = ConvexPolygon::hull(&pts);
+                    let hull = orthographic_silhouette(x, right, up);
                     match window {
                         Some((lo, hi)) => hull.clip_to_rect(lo, hi),
                         None => hull,
@@ -108,7 +106,7 @@ impl OverlapSpace {
                 window,
             } => {
                 let project = |x: &Aabb| {
-                    let hull = silhouette(x, eye, &frame, near);
+                    let hull = perspective_silhouette(x, eye, &frame, near);
                     match window {
                         Some(t) => hull.clip_to_rect(-t, t),
                         None => hull,
@@ -119,47 +117,6 @@ impl OverlapSpace {
             }
         }
     }
-}
-
-fn corner(b: &Aabb, i: usize) -> Vec3 {
-    Vec3::new(
-        if i & 1 == 0 { b.min.x } else { b.max.x },
-        if i & 2 == 0 { b.min.y } else { b.max.y },
-        if i & 4 == 0 { b.min.z } else { b.max.z },
-    )
-}
-
-/// The silhouette of `b`'s part beyond the near plane, on the image plane `z = 1`.
-fn silhouette(b: &Aabb, eye: Vec3, frame: &Frame, near: f32) -> ConvexPolygon {
-    let local: [Vec3; 8] = core::array::from_fn(|i| frame.to_local(corner(b, i) - eye));
-    let mut pts = [Vec2::ZERO; MAX_POLY];
-    let mut n = 0;
-    let project = |p: Vec3| Vec2::new(p.x / p.z, p.y / p.z);
-    for p in &local {
-        if p.z >= near && n < MAX_POLY {
-            pts[n] = project(*p);
-            n += 1;
-        }
-    }
-    if n < 8 {
-        for i in 0..8usize {
-            for bit in [1usize, 2, 4] {
-                let j = i | bit;
-                if j == i {
-                    continue;
-                }
-                let (a, c) = (local[i], local[j]);
-                if (a.z < near) != (c.z < near) && n < MAX_POLY {
-                    let t = (near - a.z) / (c.z - a.z);
-                    let mut q = a + (c - a) * t;
-                    q.z = near;
-                    pts[n] = project(q);
-                    n += 1;
-                }
-            }
-        }
-    }
-    ConvexPolygon::hull(&pts[..n])
 }
 
 /// The area of the intersection of two convex polygons (counter-clockwise, as

@@ -3,7 +3,7 @@
 use core::fmt;
 
 use super::{BinSpace, BuildArena, BuildConfig, BuildStats, Builder, CutEvaluation, ThesisCut};
-use crate::bvh::Bvh;
+use crate::bvh::{Bvh, MAX_DEPTH};
 use crate::geometry::Aabb;
 use crate::heuristics::{
     AllAxes, AxisChooser, CostConstants, CostModel, LeafSize, LongestAxis, PahOrtho,
@@ -103,6 +103,9 @@ pub struct PresetOptions {
     pub cut: ThesisCut,
     /// The quality threshold for LSPH presets.
     pub lsph_quality_threshold: f32,
+    /// Hard depth bound, at most [`crate::bvh::MAX_DEPTH`] (the thesis's `max_levels` is clamped
+    /// to it).
+    pub max_depth: u32,
 }
 
 impl Default for PresetOptions {
@@ -117,6 +120,7 @@ impl Default for PresetOptions {
             thesis_mode: false,
             cut: ThesisCut::SPFH,
             lsph_quality_threshold: ThesisCut::LSPH.quality_threshold,
+            max_depth: MAX_DEPTH,
         }
     }
 }
@@ -134,6 +138,7 @@ impl PresetOptions {
             thesis_mode: true,
             cut: ThesisCut::SPFH,
             lsph_quality_threshold: ThesisCut::LSPH.quality_threshold,
+            max_depth: MAX_DEPTH,
         }
     }
 
@@ -147,7 +152,7 @@ impl PresetOptions {
             } else {
                 BinSpace::Centroids
             },
-            ..BuildConfig::default()
+            max_depth: self.max_depth.min(MAX_DEPTH),
         }
     }
 }

@@ -7,6 +7,7 @@ mod frame;
 mod frustum;
 mod obb;
 mod polygon;
+mod projection;
 mod ray;
 mod triangle;
 
@@ -17,5 +18,6 @@ pub use frame::Frame;
 pub use frustum::Frustum;
 pub use obb::Obb;
 pub use polygon::{ConvexPolygon, MAX_POLY};
+pub use projection::{box_corner, orthographic_silhouette, perspective_silhouette};
 pub use ray::{Ray, RayError};
 pub use triangle::{Triangle, TriangleHit};

@@ -4,7 +4,7 @@
 use glam::{Vec2, Vec3};
 use wide::f32x4;
 
-use crate::geometry::{Aabb, ConvexPolygon};
+use crate::geometry::{orthographic_silhouette, Aabb};
 use crate::influence::PlaneArea;
 use crate::simd::Aabb4;
 
@@ -99,15 +99,7 @@ impl PahOrtho {
     /// The exact projected area of `b` inside the window `w`: hull of the eight projected
     /// corners, clipped to the rectangle.
     fn clipped_area(w: &Window, b: &Aabb) -> f32 {
-        let corners: [Vec2; 8] = core::array::from_fn(|i| {
-            let p = Vec3::new(
-                if i & 1 == 0 { b.min.x } else { b.max.x },
-                if i & 2 == 0 { b.min.y } else { b.max.y },
-                if i & 4 == 0 { b.min.z } else { b.max.z },
-            );
-            Vec2::new(p.dot(w.right), p.dot(w.up))
-        });
-        ConvexPolygon::hull(&corners)
+        orthographic_silhouette(b, w.right, w.up)
             .clip_to_rect(w.lo, w.hi)
             .area()
     }

@@ -3,7 +3,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::geometry::{Aabb, ConvexPolygon, Frame, MAX_POLY};
+use crate::geometry::{perspective_silhouette, Aabb, ConvexPolygon, Frame};
 use crate::influence::PointArea;
 
 use super::CostModel;
@@ -74,47 +74,7 @@ impl PahPerspective {
 
     /// The projected silhouette of `b` beyond the near plane, on the image plane `z = 1`.
     fn silhouette(&self, b: &Aabb) -> ConvexPolygon {
-        let local: [Vec3; 8] = core::array::from_fn(|i| {
-            let p = Vec3::new(
-                if i & 1 == 0 { b.min.x } else { b.max.x },
-                if i & 2 == 0 { b.min.y } else { b.max.y },
-                if i & 4 == 0 { b.min.z } else { b.max.z },
-            );
-            self.frame.to_local(p - self.eye)
-        });
-        let mut pts = [Vec2::ZERO; MAX_POLY];
-        let mut n = 0;
-        let project = |p: Vec3| Vec2::new(p.x / p.z, p.y / p.z);
-        for p in &local {
-            if p.z >= self.near {
-                pts[n] = project(*p);
-                n += 1;
-            }
-        }
-        if n < 8 {
-            // The 12 box edges join corners differing in one bit; those crossing the near plane
-            // contribute their crossing point.
-            for i in 0..8usize {
-                for bit in [1usize, 2, 4] {
-                    let j = i | bit;
-                    if j == i {
-                        continue;
-                    }
-                    let (a, c) = (local[i], local[j]);
-                    if (a.z < self.near) != (c.z < self.near) {
-                        let t = (self.near - a.z) / (c.z - a.z);
-                        let mut q = a + (c - a) * t;
-                        q.z = self.near;
-                        // At most 8 corners and the near-plane polygon's 6 vertices: n <= 14.
-                        if n < MAX_POLY {
-                            pts[n] = project(q);
-                            n += 1;
-                        }
-                    }
-                }
-            }
-        }
-        ConvexPolygon::hull(&pts[..n])
+        perspective_silhouette(b, self.eye, &self.frame, self.near)
     }
 }
 

@@ -22,7 +22,10 @@ pub struct SceneOptions {
     pub preset: Preset,
     /// Settings of the local builds.
     pub local: PresetOptions,
-    /// Settings of the fallback build (always the `sah` preset).
+    /// The fallback BVH's preset: `sah` (the default) or `standard`, which needs no area (the
+    /// thesis's fallback was SAH + LSPH).
+    pub fallback_preset: Preset,
+    /// Settings of the fallback build.
     pub fallback: PresetOptions,
     /// How many affine areas a query tries before falling back (the thesis used 1).
     pub max_tries: u32,
@@ -33,6 +36,7 @@ impl Default for SceneOptions {
         Self {
             preset: Preset::Full,
             local: PresetOptions::default(),
+            fallback_preset: Preset::Sah,
             fallback: PresetOptions::default(),
             max_tries: 1,
         }
@@ -155,7 +159,8 @@ impl<L: AreaLookup> Scene<L> {
             .load_triangles(tris)
             .map_err(|e| SceneError::Fallback(e.into()))?;
         let mut fallback = Bvh::with_capacity(tris.len());
-        Preset::Sah
+        options
+            .fallback_preset
             .build_into(None, &options.fallback, &mut arena, &mut fallback)
             .map_err(SceneError::Fallback)?;
         let lookup = lookup(&areas);

@@ -156,6 +156,7 @@ pub fn structure_options(args: &TraceArgs) -> SceneOptions {
     SceneOptions {
         preset: args.builder.preset().unwrap_or(DEFAULT_LOCAL_PRESET),
         local: args.builder.preset_options(),
+        fallback_preset: Preset::Sah,
         fallback: PresetOptions::default(),
         max_tries: args.max_tries,
     }

@@ -81,6 +81,8 @@ impl Settings {
                 quality_threshold: self.spfh_quality_threshold,
             },
             lsph_quality_threshold: self.lsph_quality_threshold,
+            // The thesis's `max_levels` (100) is above the core's bound: clamped to 64.
+            max_depth: self.max_levels.min(rdbvh_core::bvh::MAX_DEPTH),
             ..PresetOptions::thesis()
         }
     }

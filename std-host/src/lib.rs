@@ -12,3 +12,8 @@ pub mod cli;
 pub mod experiment;
 pub mod parallel;
 pub mod scene;
+
+/// The README's Rust examples, compiled as doctests so that they stay true to the API.
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+pub struct ReadmeDoctests;

@@ -18,7 +18,33 @@ use rdbvh_core::build::{BuildArena, Builder};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 
+pub mod compare;
 pub mod peers;
+
+/// A rayon pool of one thread. Single-threaded measurements run inside it, so a library whose
+/// build follows the current pool (obvhs with its `parallel` feature) builds on one thread.
+pub fn single_thread_pool() -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .thread_name(|_| "bench-1t".into())
+        .build()
+        .expect("a one-thread rayon pool")
+}
+
+/// CPU time consumed so far by the calling thread, in seconds (`CLOCK_THREAD_CPUTIME_ID`): on a
+/// machine shared with other work, it leaves out the time the scheduler gave to other processes.
+pub fn thread_cpu_seconds() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant Linux supports.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    if rc != 0 {
+        return 0.0;
+    }
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
 
 /// Where the shared test scenes live: `../shared/scenes` beside the project's checkout.
 pub const SCENES_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/scenes");

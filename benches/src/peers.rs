@@ -12,8 +12,9 @@
 //!   high-quality build". It is measured twice: `obvhs-bvh2` (`build_bvh2_from_tris`, its binary
 //!   tree, the same node kind as rdbvh) and `obvhs-cwbvh` (`build_cwbvh_from_tris`, its
 //!   8-wide compressed tree with SIMD traversal, the structure obvhs is built for and its fastest
-//!   traversal). Its `parallel` feature is off, so both builds are single-threaded. Triangle test:
-//!   obvhs's own double-sided Moller-Trumbore (`Triangle::intersect`).
+//!   traversal). Its `parallel` feature is on (for the threaded builds), so its single-threaded
+//!   builds run inside a one-thread rayon pool. Triangle test: obvhs's own double-sided
+//!   Moller-Trumbore (`Triangle::intersect`).
 //! - **bvh 0.13**: `Bvh::build` (its binned SAH over the longest centroid axis, one shape per
 //!   leaf; the serial executor). Traversal: `bvh` has no closest-hit query of its own, only
 //!   iterators over the shapes whose boxes a ray crosses, so closest hit walks
@@ -48,9 +49,20 @@ pub trait Library {
     fn scene(tris: &[Triangle]) -> Self::Scene;
     /// Converts rays to the library's format (not timed).
     fn rays(rays: &[Ray]) -> Vec<Self::Ray>;
-    /// Builds the acceleration structure, single-threaded (the timed build). Mutable because
-    /// `bvh` writes node indices into its shapes.
+    /// How [`Library::build_mt`] uses threads, for reports; `None` when the library has no
+    /// threaded build and `build_mt` is its single-threaded build.
+    const PARALLEL_BUILD: Option<&'static str>;
+
+    /// Builds the acceleration structure (the timed build). Mutable because `bvh` writes node
+    /// indices into its shapes. Single-threaded for rdbvh, `bvh` and parry3d; obvhs (built with
+    /// its `parallel` feature) uses the current rayon pool, so callers that want its
+    /// single-threaded build run this inside a one-thread pool ([`crate::single_thread_pool`]).
     fn build(scene: &mut Self::Scene) -> Self::Accel;
+    /// The library's threaded build, on the current rayon pool; [`Library::build`] when it has
+    /// none.
+    fn build_mt(scene: &mut Self::Scene) -> Self::Accel {
+        Self::build(scene)
+    }
     /// The closest hit's distance along the ray, or `None`.
     fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> Option<f32>;
     /// Whether anything is hit along the ray.
@@ -110,6 +122,8 @@ pub struct Rdbvh;
 
 impl Library for Rdbvh {
     const NAME: &'static str = "rdbvh";
+    const PARALLEL_BUILD: Option<&'static str> =
+        Some("rdbvh::parallel::build (rayon; the single-threaded tree, node for node)");
     type Scene = Vec<Triangle>;
     type Ray = Ray;
     type Accel = rdbvh_core::bvh::Bvh;
@@ -124,6 +138,9 @@ impl Library for Rdbvh {
         Builder::sah()
             .build(scene)
             .expect("scene triangles are finite")
+    }
+    fn build_mt(scene: &mut Self::Scene) -> Self::Accel {
+        rdbvh::parallel::build(&Builder::sah(), scene).expect("scene triangles are finite")
     }
     #[inline]
     fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Ray) -> Option<f32> {
@@ -142,6 +159,8 @@ pub struct RdbvhWide;
 
 impl Library for RdbvhWide {
     const NAME: &'static str = "rdbvh-wide";
+    const PARALLEL_BUILD: Option<&'static str> =
+        Some("rdbvh::parallel::build, then the single-threaded 4-wide collapse");
     type Scene = Vec<Triangle>;
     type Ray = Ray;
     type Accel = rdbvh_core::bvh::WideBvh;
@@ -154,6 +173,9 @@ impl Library for RdbvhWide {
     }
     fn build(scene: &mut Self::Scene) -> Self::Accel {
         rdbvh_core::bvh::WideBvh::from_binary(&Rdbvh::build(scene))
+    }
+    fn build_mt(scene: &mut Self::Scene) -> Self::Accel {
+        rdbvh_core::bvh::WideBvh::from_binary(&Rdbvh::build_mt(scene))
     }
     #[inline]
     fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Ray) -> Option<f32> {
@@ -186,6 +208,8 @@ pub struct ObvhsBvh2;
 
 impl Library for ObvhsBvh2 {
     const NAME: &'static str = "obvhs-bvh2";
+    const PARALLEL_BUILD: Option<&'static str> =
+        Some("the same call with obvhs's `parallel` feature on the all-thread rayon pool");
     type Scene = Vec<obvhs::triangle::Triangle>;
     type Ray = obvhs::ray::Ray;
     type Accel = obvhs::bvh2::Bvh2;
@@ -225,6 +249,8 @@ pub struct ObvhsCwbvh;
 
 impl Library for ObvhsCwbvh {
     const NAME: &'static str = "obvhs-cwbvh";
+    const PARALLEL_BUILD: Option<&'static str> =
+        Some("the same call with obvhs's `parallel` feature on the all-thread rayon pool");
     type Scene = Vec<obvhs::triangle::Triangle>;
     type Ray = obvhs::ray::Ray;
     type Accel = obvhs::cwbvh::CwBvh;
@@ -301,6 +327,8 @@ pub struct BvhCrate;
 
 impl Library for BvhCrate {
     const NAME: &'static str = "bvh";
+    const PARALLEL_BUILD: Option<&'static str> =
+        Some("Bvh::build_par (rayon::join over subtrees of 64 nodes and more)");
     type Scene = Vec<BvhShape>;
     type Ray = BvhRay;
     type Accel = bvh::bvh::Bvh<f32, 3>;
@@ -321,6 +349,10 @@ impl Library for BvhCrate {
     }
     fn build(scene: &mut Self::Scene) -> Self::Accel {
         bvh::bvh::Bvh::build(scene)
+    }
+    fn build_mt(scene: &mut Self::Scene) -> Self::Accel {
+        use bvh::bounding_hierarchy::BoundingHierarchy;
+        bvh::bvh::Bvh::build_par(scene)
     }
     #[inline]
     fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> Option<f32> {
@@ -364,6 +396,8 @@ fn pv(v: Vec3) -> parry3d::math::Vector {
 
 impl Library for Parry {
     const NAME: &'static str = "parry3d";
+    /// parry3d 0.31 builds on one thread ("neither strategy is currently parallelized").
+    const PARALLEL_BUILD: Option<&'static str> = None;
     type Scene = ParryScene;
     type Ray = parry3d::query::Ray;
     type Accel = parry3d::partitioning::Bvh;

@@ -1,0 +1,20 @@
+//! `peers SCENE.obj [--json] [--wall]`: rdbvh beside obvhs 0.4, bvh 0.13 and parry3d 0.31 on the
+//! same triangles and rays (see `rdbvh_benches::compare`). Bad input prints one `error: ...`
+//! line and exits with status 1.
+
+use std::process::ExitCode;
+
+use rdbvh_benches::compare::{main_with, Options};
+
+fn main() -> ExitCode {
+    match main_with(std::env::args().skip(1), Options::default()) {
+        Ok(out) => {
+            print!("{out}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {}", e.replace('\n', " "));
+            ExitCode::FAILURE
+        }
+    }
+}

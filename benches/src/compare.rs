@@ -1,0 +1,681 @@
+//! The peer comparison behind the `peers` binary: one scene, the same triangles and the same rays
+//! for rdbvh (binary and 4-wide), obvhs 0.4, bvh 0.13 and parry3d 0.31; single-threaded and
+//! threaded builds, closest hit on camera and random rays, any hit on random rays; every
+//! library's answers checked against rdbvh's before any number is reported.
+//!
+//! **Clocks.** Single-threaded measurements (`build_1t` and the traversals) report the best
+//! repetition's CPU time of the thread that ran them (`CLOCK_THREAD_CPUTIME_ID`), because the
+//! reference machine is shared: wall time there measures the neighbours as much as the code.
+//! `build_mt` can only be wall time (its work is spread over threads), so it is the best
+//! repetition's wall time; [`Clock::Wall`] reports wall time everywhere. The 2-thread scaling is
+//! always wall over wall.
+//!
+//! **The JSON contract.** [`Report::json_lines`] prints one object per line with exactly the
+//! keys `library` ([`LIBRARIES`]), `measure` ([`Measure::name`]), `value` and `unit`
+//! (`Mtris/s` or `Mrays/s`). obvhs is measured twice (its binary tree and its 8-wide compressed
+//! tree); under `obvhs`, builds report its binary-tree build (its fastest, the one issue 6's
+//! build target must beat) and each traversal reports the faster of the two trees, which the
+//! text output names.
+
+use std::fmt::Write as _;
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+use rdbvh_core::build::{BuildArena, Builder, Preset, PresetOptions};
+use rdbvh_core::bvh::Bvh;
+use rdbvh_core::geometry::{Aabb, Ray, Triangle};
+use rdbvh_core::influence::{InfluenceArea, PlaneArea, PointArea};
+
+use crate::peers::{BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Prepared, Rdbvh, RdbvhWide};
+use crate::{
+    agreement, bounds, ray_set, single_thread_pool, thread_cpu_seconds, Agreement, Answers,
+    RayKind, MIN_AGREEMENT,
+};
+
+/// The library names of the JSON output, in output order.
+pub const LIBRARIES: [&str; 5] = ["rdbvh", "rdbvh-wide", "obvhs", "bvh", "parry3d"];
+
+/// What is measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Measure {
+    /// Build on one thread, triangles per second.
+    Build1t,
+    /// Build on every thread of the machine (wall time), triangles per second.
+    BuildMt,
+    /// Closest hit of the camera rays.
+    ClosestCamera,
+    /// Closest hit of the random rays.
+    ClosestRandom,
+    /// Any hit of the random rays.
+    AnyRandom,
+}
+
+impl Measure {
+    /// Every measure, in output order.
+    pub const ALL: [Measure; 5] = [
+        Measure::Build1t,
+        Measure::BuildMt,
+        Measure::ClosestCamera,
+        Measure::ClosestRandom,
+        Measure::AnyRandom,
+    ];
+
+    /// The name in the JSON output.
+    pub fn name(self) -> &'static str {
+        match self {
+            Measure::Build1t => "build_1t",
+            Measure::BuildMt => "build_mt",
+            Measure::ClosestCamera => "closest_camera",
+            Measure::ClosestRandom => "closest_random",
+            Measure::AnyRandom => "any_random",
+        }
+    }
+
+    /// The unit of its value.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Measure::Build1t | Measure::BuildMt => "Mtris/s",
+            _ => "Mrays/s",
+        }
+    }
+
+    fn is_build(self) -> bool {
+        matches!(self, Measure::Build1t | Measure::BuildMt)
+    }
+}
+
+/// Which clock single-threaded measurements report.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Clock {
+    /// CPU time of the measuring thread (the default; `build_mt` is wall time regardless).
+    ThreadCpu,
+    /// Wall time for everything.
+    Wall,
+}
+
+/// How long to measure.
+#[derive(Clone, Copy, Debug)]
+pub struct Options {
+    /// Fewest repetitions of every measurement.
+    pub min_reps: usize,
+    /// Most repetitions of every measurement.
+    pub max_reps: usize,
+    /// After `min_reps`, repeat while a measurement has taken less than this.
+    pub budget: Duration,
+    /// The clock of single-threaded measurements.
+    pub clock: Clock,
+    /// Also measure rdbvh's PAH builds against its SAH build.
+    pub pah: bool,
+}
+
+impl Default for Options {
+    /// 3 to 7 repetitions within about a second per measurement: Sponza runs in well under a
+    /// minute on 2 cores.
+    fn default() -> Self {
+        Self {
+            min_reps: 3,
+            max_reps: 7,
+            budget: Duration::from_millis(1000),
+            clock: Clock::ThreadCpu,
+            pah: true,
+        }
+    }
+}
+
+/// The best repetition of a measurement, by each clock, in seconds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Timing {
+    /// Best CPU time of the measuring thread.
+    pub cpu: f64,
+    /// Best wall time.
+    pub wall: f64,
+    /// Repetitions run.
+    pub reps: usize,
+}
+
+/// Runs `f` between `min_reps` and `max_reps` times on the calling thread; outputs are dropped
+/// outside the timing.
+fn best_of<R>(opts: &Options, mut f: impl FnMut() -> R) -> Timing {
+    let start = Instant::now();
+    let mut best = Timing {
+        cpu: f64::INFINITY,
+        wall: f64::INFINITY,
+        reps: 0,
+    };
+    while best.reps < opts.min_reps.max(1)
+        || (best.reps < opts.max_reps && start.elapsed() < opts.budget)
+    {
+        let c0 = thread_cpu_seconds();
+        let w0 = Instant::now();
+        let out = f();
+        let wall = w0.elapsed().as_secs_f64();
+        let cpu = thread_cpu_seconds() - c0;
+        drop(out);
+        best.cpu = best.cpu.min(cpu);
+        best.wall = best.wall.min(wall);
+        best.reps += 1;
+    }
+    best
+}
+
+/// One library's measurements, before obvhs's two trees are folded into one name.
+#[derive(Clone, Debug)]
+pub struct LibraryRun {
+    /// The adapter's name (`obvhs-bvh2`, `obvhs-cwbvh` for obvhs).
+    pub name: &'static str,
+    /// Its threaded build, or `None` when `build_mt` is its one-thread build.
+    pub parallel_build: Option<&'static str>,
+    /// Timings per measure, in [`Measure::ALL`] order.
+    pub timings: [Timing; 5],
+    /// Agreement with rdbvh on the camera and random rays, tree of the one-thread build.
+    pub agreement: [Agreement; 2],
+    /// Agreement with rdbvh on the camera and random rays, tree of the threaded build.
+    pub agreement_mt: [Agreement; 2],
+}
+
+/// One reported number.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    /// One of [`LIBRARIES`].
+    pub library: &'static str,
+    /// What was measured.
+    pub measure: Measure,
+    /// Millions of triangles or rays per second.
+    pub value: f64,
+    /// The adapter that produced the number (differs from `library` only for obvhs).
+    pub source: &'static str,
+}
+
+/// rdbvh's PAH builds beside its SAH build, single-threaded, on the same triangles.
+#[derive(Clone, Debug)]
+pub struct PahBuilds {
+    /// `Preset::Sah`.
+    pub sah: Timing,
+    /// `Preset::Full` (PAH + SPFH) with a plane area over the scene (parallel rays).
+    pub full_plane: Timing,
+    /// `Preset::Full` with a point area over the scene (radial rays, perspective PAH).
+    pub full_point: Timing,
+}
+
+/// Everything one run measured.
+#[derive(Clone, Debug)]
+pub struct Report {
+    /// The scene as given.
+    pub scene: String,
+    /// Triangles.
+    pub triangles: usize,
+    /// Rays per set.
+    pub rays: [usize; 2],
+    /// Share of rays rdbvh finds a hit for, camera and random.
+    pub hit_share: [f64; 2],
+    /// Threads of the threaded builds.
+    pub threads: usize,
+    /// The clock of single-threaded numbers.
+    pub clock: Clock,
+    /// `/proc/loadavg`'s first three fields before and after the run.
+    pub load: [String; 2],
+    /// Per adapter.
+    pub runs: Vec<LibraryRun>,
+    /// The reported numbers, [`LIBRARIES`] x [`Measure::ALL`].
+    pub rows: Vec<Row>,
+    /// PAH against SAH, when measured.
+    pub pah: Option<PahBuilds>,
+}
+
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "unknown".into())
+}
+
+/// The measurement of one adapter: builds (one thread, all threads), agreement of both trees
+/// with `sets`' reference answers, then the three traversals.
+fn measure<L: Library>(
+    tris: &[Triangle],
+    sets: &[(RayKind, Vec<Ray>, Answers)],
+    opts: &Options,
+    one: &rayon::ThreadPool,
+    all: &rayon::ThreadPool,
+) -> Result<LibraryRun, String>
+where
+    L::Scene: Send,
+    L::Accel: Send,
+{
+    let mut scene = L::scene(tris);
+    let build_1t = one.install(|| best_of(opts, || L::build(&mut scene)));
+    let build_mt = match L::PARALLEL_BUILD {
+        Some(_) => all.install(|| best_of(opts, || L::build_mt(&mut scene))),
+        None => build_1t,
+    };
+    let check = |prepared: &Prepared<L>, which: &str| -> Result<[Agreement; 2], String> {
+        let mut out = [Agreement {
+            rays: 0,
+            closest: 1.0,
+            any: 1.0,
+        }; 2];
+        for (slot, (kind, rays, reference)) in out.iter_mut().zip(sets) {
+            let g = agreement(reference, &prepared.answers(&L::rays(rays)));
+            if g.closest < MIN_AGREEMENT || g.any < MIN_AGREEMENT {
+                return Err(format!(
+                    "{} ({which} build) disagrees with rdbvh on the {} rays: closest hit {:.4}%, \
+                     any hit {:.4}% of {} rays (at least {}% required)",
+                    L::NAME,
+                    kind.name(),
+                    100.0 * g.closest,
+                    100.0 * g.any,
+                    g.rays,
+                    100.0 * MIN_AGREEMENT
+                ));
+            }
+            *slot = g;
+        }
+        Ok(out)
+    };
+    let agreement_mt = {
+        let accel = all.install(|| L::build_mt(&mut scene));
+        let prepared = Prepared::<L> { scene, accel };
+        let g = check(&prepared, "threaded")?;
+        scene = prepared.scene;
+        g
+    };
+    let accel = one.install(|| L::build(&mut scene));
+    let prepared = Prepared::<L> { scene, accel };
+    let agreement_1t = check(&prepared, "one-thread")?;
+    let native = |kind: RayKind| {
+        let set = sets.iter().find(|(k, _, _)| *k == kind).expect("ray set");
+        L::rays(&set.1)
+    };
+    let camera = native(RayKind::Camera);
+    let random = native(RayKind::Random);
+    let closest_camera = best_of(opts, || prepared.closest_all(std::hint::black_box(&camera)));
+    let closest_random = best_of(opts, || prepared.closest_all(std::hint::black_box(&random)));
+    let any_random = best_of(opts, || prepared.any_all(std::hint::black_box(&random)));
+    Ok(LibraryRun {
+        name: L::NAME,
+        parallel_build: L::PARALLEL_BUILD,
+        timings: [
+            build_1t,
+            build_mt,
+            closest_camera,
+            closest_random,
+            any_random,
+        ],
+        agreement: agreement_1t,
+        agreement_mt,
+    })
+}
+
+/// A plane area over `b`: a light rectangle on top of the box (largest y), rays straight down,
+/// wide enough to cover the box whatever the rectangle's rotation about y, as deep as the box.
+pub fn plane_area_over(b: &Aabb) -> Result<PlaneArea, String> {
+    let e = (b.max - b.min).max(Vec3::splat(1e-3 * (b.max - b.min).length().max(1e-6)));
+    let c = b.center();
+    let half = 0.5 * (e.x * e.x + e.z * e.z).sqrt();
+    PlaneArea::new(Vec3::new(c.x, b.max.y, c.z), -Vec3::Y, half, half, e.y)
+        .map_err(|e| format!("plane area over the scene: {e}"))
+}
+
+/// A point area over `b`: a light above the box looking down, its frustum holding the box's
+/// bounding sphere.
+pub fn point_area_over(b: &Aabb) -> Result<PointArea, String> {
+    let c = b.center();
+    let r = (0.5 * (b.max - b.min).length()).max(1e-6);
+    let dist = 2.0 * r;
+    let fov = (2.0 * (r / dist).asin().to_degrees() * 1.1).min(170.0);
+    PointArea::new(c + Vec3::Y * dist, -Vec3::Y, fov, fov, 0.0, dist + r)
+        .map_err(|e| format!("point area over the scene: {e}"))
+}
+
+fn measure_pah(tris: &[Triangle], b: &Aabb, opts: &Options) -> Result<PahBuilds, String> {
+    let plane: InfluenceArea = plane_area_over(b)?.into();
+    let point: InfluenceArea = point_area_over(b)?.into();
+    let options = PresetOptions::default();
+    let mut arena = BuildArena::with_capacity(tris.len());
+    let mut bvh = Bvh::with_capacity(tris.len());
+    let mut one = |preset: Preset, area: Option<&InfluenceArea>| -> Result<Timing, String> {
+        let mut err = None;
+        let t = best_of(opts, || {
+            let r = arena
+                .load_triangles(tris)
+                .map_err(|e| e.to_string())
+                .and_then(|_| {
+                    preset
+                        .build_into(area, &options, &mut arena, &mut bvh)
+                        .map_err(|e| e.to_string())
+                });
+            if let Err(e) = r {
+                err = Some(e);
+            }
+        });
+        match err {
+            Some(e) => Err(format!("{preset} build: {e}")),
+            None => Ok(t),
+        }
+    };
+    Ok(PahBuilds {
+        sah: one(Preset::Sah, None)?,
+        full_plane: one(Preset::Full, Some(&plane))?,
+        full_point: one(Preset::Full, Some(&point))?,
+    })
+}
+
+/// Measures every library on `tris` (named `scene` in the report).
+pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, String> {
+    if tris.is_empty() {
+        return Err(format!("{scene} has no triangles"));
+    }
+    // Validate once with rdbvh's typed errors, so no adapter's `expect` can fire.
+    Builder::sah()
+        .build(tris)
+        .map_err(|e| format!("{scene}: {e}"))?;
+    let load_before = load_average();
+    let one = single_thread_pool();
+    let all = rayon::ThreadPoolBuilder::new()
+        .thread_name(|i| format!("bench-mt-{i}"))
+        .build()
+        .map_err(|e| format!("cannot start the rayon pool: {e}"))?;
+    let b = bounds(tris);
+    let reference = Prepared::<Rdbvh>::new(tris);
+    let sets: Vec<(RayKind, Vec<Ray>, Answers)> = [RayKind::Camera, RayKind::Random]
+        .into_iter()
+        .map(|kind| {
+            let rays = ray_set(&b, kind);
+            let answers = reference.answers(&rays);
+            (kind, rays, answers)
+        })
+        .collect();
+    drop(reference);
+    let share = |a: &Answers| {
+        a.closest.iter().filter(|t| t.is_some()).count() as f64 / a.closest.len().max(1) as f64
+    };
+    let runs = vec![
+        measure::<Rdbvh>(tris, &sets, opts, &one, &all)?,
+        measure::<RdbvhWide>(tris, &sets, opts, &one, &all)?,
+        measure::<ObvhsBvh2>(tris, &sets, opts, &one, &all)?,
+        measure::<ObvhsCwbvh>(tris, &sets, opts, &one, &all)?,
+        measure::<BvhCrate>(tris, &sets, opts, &one, &all)?,
+        measure::<Parry>(tris, &sets, opts, &one, &all)?,
+    ];
+    let pah = if opts.pah {
+        Some(measure_pah(tris, &b, opts)?)
+    } else {
+        None
+    };
+    let n = tris.len();
+    let rows = fold_rows(&runs, n, sets[0].1.len(), sets[1].1.len(), opts.clock);
+    Ok(Report {
+        scene: scene.to_string(),
+        triangles: n,
+        rays: [sets[0].1.len(), sets[1].1.len()],
+        hit_share: [share(&sets[0].2), share(&sets[1].2)],
+        threads: all.current_num_threads(),
+        clock: opts.clock,
+        load: [load_before, load_average()],
+        runs,
+        rows,
+        pah,
+    })
+}
+
+/// Millions per second from a count and a timing, by the clock the measure reports.
+fn rate(count: usize, t: &Timing, measure: Measure, clock: Clock) -> f64 {
+    let secs = if measure == Measure::BuildMt || clock == Clock::Wall {
+        t.wall
+    } else {
+        t.cpu
+    };
+    count as f64 / secs.max(1e-9) / 1e6
+}
+
+/// Folds the adapters into the reported libraries: obvhs's build is its binary tree's, each of
+/// its traversals the faster tree's.
+fn fold_rows(
+    runs: &[LibraryRun],
+    tris: usize,
+    camera: usize,
+    random: usize,
+    clock: Clock,
+) -> Vec<Row> {
+    let value = |run: &LibraryRun, m: Measure| {
+        let (i, count) = match m {
+            Measure::Build1t => (0, tris),
+            Measure::BuildMt => (1, tris),
+            Measure::ClosestCamera => (2, camera),
+            Measure::ClosestRandom => (3, random),
+            Measure::AnyRandom => (4, random),
+        };
+        rate(count, &run.timings[i], m, clock)
+    };
+    let find = |name: &str| runs.iter().find(|r| r.name == name).expect("measured");
+    let mut rows = Vec::new();
+    for library in LIBRARIES {
+        for m in Measure::ALL {
+            let (source, v) = if library == "obvhs" {
+                let bvh2 = find("obvhs-bvh2");
+                let cw = find("obvhs-cwbvh");
+                let (a, b) = (value(bvh2, m), value(cw, m));
+                if m.is_build() || a >= b {
+                    (bvh2.name, a)
+                } else {
+                    (cw.name, b)
+                }
+            } else {
+                let r = find(library);
+                (r.name, value(r, m))
+            };
+            rows.push(Row {
+                library,
+                measure: m,
+                value: v,
+                source,
+            });
+        }
+    }
+    rows
+}
+
+impl Report {
+    /// The reported number of `library` for `measure`.
+    pub fn value(&self, library: &str, measure: Measure) -> Option<f64> {
+        self.rows
+            .iter()
+            .find(|r| r.library == library && r.measure == measure)
+            .map(|r| r.value)
+    }
+
+    /// One JSON object per row: `library`, `measure`, `value` (rounded to 4 decimals) and `unit`.
+    pub fn json_lines(&self) -> Vec<String> {
+        self.rows
+            .iter()
+            .map(|r| {
+                format!(
+                    "{{\"library\":\"{}\",\"measure\":\"{}\",\"value\":{:.4},\"unit\":\"{}\"}}",
+                    r.library,
+                    r.measure.name(),
+                    if r.value.is_finite() { r.value } else { 0.0 },
+                    r.measure.unit()
+                )
+            })
+            .collect()
+    }
+
+    /// rdbvh's build speed-up from 1 thread to all threads, wall time over wall time.
+    pub fn rdbvh_scaling(&self) -> f64 {
+        let r = self.runs.iter().find(|r| r.name == "rdbvh").expect("rdbvh");
+        r.timings[0].wall / r.timings[1].wall.max(1e-12)
+    }
+
+    /// The human-readable report.
+    pub fn text(&self) -> String {
+        let mut s = String::new();
+        let w = &mut s;
+        let _ = writeln!(
+            w,
+            "scene {}: {} triangles; {} camera rays ({:.1}% hit), {} random rays ({:.1}% hit)",
+            self.scene,
+            self.triangles,
+            self.rays[0],
+            100.0 * self.hit_share[0],
+            self.rays[1],
+            100.0 * self.hit_share[1]
+        );
+        let _ = writeln!(
+            w,
+            "load average {} before, {} after; build_mt on {} threads",
+            self.load[0], self.load[1], self.threads
+        );
+        let _ = writeln!(
+            w,
+            "clock: {}; best of {}-{} repetitions; (ratio) = value / rdbvh's, higher is faster",
+            match self.clock {
+                Clock::ThreadCpu =>
+                    "thread CPU time for build_1t and traversals, wall time for build_mt",
+                Clock::Wall => "wall time everywhere",
+            },
+            self.runs
+                .iter()
+                .flat_map(|r| r.timings.iter().map(|t| t.reps))
+                .min()
+                .unwrap_or(0),
+            self.runs
+                .iter()
+                .flat_map(|r| r.timings.iter().map(|t| t.reps))
+                .max()
+                .unwrap_or(0),
+        );
+        let _ = writeln!(w);
+        let _ = write!(w, "{:<11}", "library");
+        for m in Measure::ALL {
+            let _ = write!(w, " {:>24}", format!("{} {}", m.name(), m.unit()));
+        }
+        let _ = writeln!(w);
+        for library in LIBRARIES {
+            let _ = write!(w, "{library:<11}");
+            for m in Measure::ALL {
+                let v = self.value(library, m).unwrap_or(0.0);
+                let base = self.value("rdbvh", m).unwrap_or(0.0);
+                let cell = if library == "rdbvh" {
+                    format!("{v:.2}")
+                } else {
+                    format!("{v:.2} ({:.2}x)", v / base.max(1e-12))
+                };
+                let _ = write!(w, " {cell:>24}");
+            }
+            let _ = writeln!(w);
+        }
+        let _ = writeln!(w);
+        let obvhs: Vec<String> = self
+            .rows
+            .iter()
+            .filter(|r| r.library == "obvhs")
+            .map(|r| format!("{} {}", r.measure.name(), r.source))
+            .collect();
+        let _ = writeln!(
+            w,
+            "obvhs: its fast_build (PLOC); builds are obvhs-bvh2's (its faster build), traversals \
+             its faster tree: {}",
+            obvhs.join(", ")
+        );
+        for r in &self.runs {
+            let _ = writeln!(
+                w,
+                "build_mt {}: {}",
+                r.name,
+                r.parallel_build
+                    .unwrap_or("no threaded build; build_mt reports its 1-thread build")
+            );
+        }
+        let _ = writeln!(
+            w,
+            "rdbvh build scaling, {} threads vs 1 (wall/wall): {:.2}x",
+            self.threads,
+            self.rdbvh_scaling()
+        );
+        let _ = writeln!(w);
+        let _ = writeln!(
+            w,
+            "agreement with rdbvh (closest / any hit), 1-thread tree | threaded tree:"
+        );
+        for r in &self.runs {
+            let cell = |g: &Agreement| format!("{:.4}% / {:.4}%", 100.0 * g.closest, 100.0 * g.any);
+            let _ = writeln!(
+                w,
+                "  {:<12} camera {} | {}   random {} | {}",
+                r.name,
+                cell(&r.agreement[0]),
+                cell(&r.agreement_mt[0]),
+                cell(&r.agreement[1]),
+                cell(&r.agreement_mt[1]),
+            );
+        }
+        if let Some(p) = &self.pah {
+            let m = |t: &Timing| rate(self.triangles, t, Measure::Build1t, self.clock);
+            let (sah, plane, point) = (m(&p.sah), m(&p.full_plane), m(&p.full_point));
+            let _ = writeln!(w);
+            let _ = writeln!(
+                w,
+                "PAH vs SAH, rdbvh presets, 1 thread: sah {sah:.2} Mtris/s; full (PAH+SPFH) plane \
+                 area {plane:.2} Mtris/s ({:.2}x the SAH time); full point area {point:.2} \
+                 Mtris/s ({:.2}x the SAH time)",
+                sah / plane.max(1e-12),
+                sah / point.max(1e-12)
+            );
+        }
+        s
+    }
+}
+
+/// What the `peers` binary was asked for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Args {
+    /// An OBJ path or `builtin:NAME`.
+    pub scene: String,
+    /// JSON lines instead of the text report.
+    pub json: bool,
+    /// Wall time for every measure.
+    pub wall: bool,
+}
+
+/// The usage line.
+pub const USAGE: &str = "usage: peers SCENE.obj|builtin:NAME [--json] [--wall]";
+
+/// Parses the binary's arguments.
+pub fn parse_args(args: impl IntoIterator<Item = String>) -> Result<Args, String> {
+    let mut scene = None;
+    let mut json = false;
+    let mut wall = false;
+    for a in args {
+        match a.as_str() {
+            "--json" => json = true,
+            "--wall" => wall = true,
+            "-h" | "--help" => return Err(USAGE.to_string()),
+            s if s.starts_with("--") => return Err(format!("unknown option {s}; {USAGE}")),
+            s => {
+                if scene.replace(s.to_string()).is_some() {
+                    return Err(format!("more than one scene given; {USAGE}"));
+                }
+            }
+        }
+    }
+    let scene = scene.ok_or_else(|| format!("no scene given; {USAGE}"))?;
+    Ok(Args { scene, json, wall })
+}
+
+/// The whole binary: loads the scene, measures, and returns what to print.
+pub fn main_with(args: impl IntoIterator<Item = String>, opts: Options) -> Result<String, String> {
+    let args = parse_args(args)?;
+    let scene = rdbvh::scene::Scene::open(&args.scene)
+        .map_err(|e| format!("cannot load {}: {e}", args.scene))?;
+    let opts = Options {
+        clock: if args.wall { Clock::Wall } else { opts.clock },
+        ..opts
+    };
+    let report = run(&args.scene, &scene.triangles, &opts)?;
+    Ok(if args.json {
+        let mut s = report.json_lines().join("\n");
+        s.push('\n');
+        s
+    } else {
+        report.text()
+    })
+}

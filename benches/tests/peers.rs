@@ -1,0 +1,109 @@
+//! The `peers` comparison on a built-in scene (no `../shared` needed): the JSON lines keep their
+//! contract (exact keys, every library and measure once, the right units), every library agrees
+//! with rdbvh, and bad input is one `error:` line with a failing exit status.
+
+use std::collections::BTreeSet;
+use std::process::Command;
+use std::time::Duration;
+
+use rdbvh_benches::compare::{main_with, Clock, Measure, Options, LIBRARIES};
+use rdbvh_benches::MIN_AGREEMENT;
+
+fn quick() -> Options {
+    Options {
+        min_reps: 1,
+        max_reps: 1,
+        budget: Duration::ZERO,
+        clock: Clock::ThreadCpu,
+        pah: true,
+    }
+}
+
+fn args(a: &[&str]) -> Vec<String> {
+    a.iter().map(|s| s.to_string()).collect()
+}
+
+#[test]
+fn json_lines_keep_the_contract_and_libraries_agree() {
+    let out = main_with(args(&["builtin:random1000", "--json"]), quick()).expect("runs");
+    let mut seen = BTreeSet::new();
+    for line in out.lines() {
+        let v: serde_json::Value = serde_json::from_str(line).expect("one JSON object per line");
+        let o = v.as_object().expect("an object");
+        let keys: BTreeSet<&str> = o.keys().map(String::as_str).collect();
+        assert_eq!(
+            keys,
+            BTreeSet::from(["library", "measure", "value", "unit"]),
+            "{line}"
+        );
+        let library = o["library"].as_str().unwrap();
+        let measure = o["measure"].as_str().unwrap();
+        assert!(LIBRARIES.contains(&library), "{line}");
+        let m = Measure::ALL
+            .into_iter()
+            .find(|m| m.name() == measure)
+            .unwrap_or_else(|| panic!("unknown measure in {line}"));
+        assert_eq!(o["unit"].as_str().unwrap(), m.unit(), "{line}");
+        let value = o["value"].as_f64().expect("a number");
+        assert!(value.is_finite() && value > 0.0, "{line}");
+        assert!(
+            seen.insert((library.to_string(), measure.to_string())),
+            "twice: {line}"
+        );
+    }
+    assert_eq!(seen.len(), LIBRARIES.len() * Measure::ALL.len());
+}
+
+#[test]
+fn every_library_agrees_with_rdbvh_on_both_trees() {
+    let scene = rdbvh::scene::Scene::open("builtin:random1000").unwrap();
+    let report = rdbvh_benches::compare::run("builtin:random1000", &scene.triangles, &quick())
+        .expect("runs");
+    assert_eq!(report.runs.len(), 6);
+    for r in &report.runs {
+        for g in r.agreement.iter().chain(&r.agreement_mt) {
+            assert!(g.rays > 0);
+            assert!(
+                g.closest >= MIN_AGREEMENT && g.any >= MIN_AGREEMENT,
+                "{}: {g:?}",
+                r.name
+            );
+        }
+    }
+    // Hits exist in both ray sets, so the agreement is not only on misses.
+    assert!(
+        report.hit_share.iter().all(|&s| s > 0.05),
+        "{:?}",
+        report.hit_share
+    );
+    let text = report.text();
+    assert!(text.contains("parry3d: no threaded build"), "{text}");
+    assert!(text.contains("PAH vs SAH"), "{text}");
+}
+
+#[test]
+fn bad_input_is_one_error_line() {
+    let dir = std::env::temp_dir().join(format!("rdbvh-peers-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let empty = dir.join("empty.obj");
+    std::fs::write(&empty, "# no faces\nv 0 0 0\n").unwrap();
+    let missing = dir.join("missing.obj");
+    for a in [
+        vec![missing.to_str().unwrap().to_string()],
+        vec![empty.to_str().unwrap().to_string(), "--json".into()],
+        vec![],
+        vec!["builtin:nope".into()],
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_peers"))
+            .args(&a)
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{a:?}");
+        assert!(out.stdout.is_empty(), "{a:?}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(err.lines().count(), 1, "{a:?}: {err}");
+        assert!(err.starts_with("error: "), "{a:?}: {err}");
+        assert!(!err.contains("panicked"), "{a:?}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

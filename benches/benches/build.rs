@@ -1,5 +1,9 @@
-//! Single-threaded BVH builds on the bunny and Crytek Sponza: rdbvh's binned SAH beside the
-//! peers' builders, throughput in triangles.
+//! BVH builds on the bunny and Crytek Sponza: rdbvh's binned SAH beside the peers' builders,
+//! throughput in triangles. `build/SCENE/LIB` is the single-threaded build (inside a one-thread
+//! rayon pool, so obvhs's `parallel` feature cannot spread it; clock per `RDBVH_BENCH_CLOCK`),
+//! `build_mt/SCENE/LIB` the threaded build on every core, always in wall time (its work is on
+//! several threads), and `build_pah/SCENE/...` rdbvh's SAH preset beside PAH + SPFH (`full`) with
+//! a plane and a point area over the scene. These are the rows of the `peers` binary's table.
 //!
 //! Each library builds from triangles already in its own format (converted once, untimed); the
 //! timed build includes bounding the triangles, which every builder must do. Outputs are dropped
@@ -11,16 +15,56 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use clock::Clock;
-use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
+use criterion::measurement::{Measurement, WallTime};
+use criterion::{
+    criterion_group, criterion_main, BenchmarkGroup, Criterion, SamplingMode, Throughput,
+};
+use rdbvh_benches::compare::{plane_area_over, point_area_over};
 use rdbvh_benches::peers::{BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Rdbvh, RdbvhWide};
-use rdbvh_benches::{load_scene, RdbvhReuse, BENCH_SCENES};
+use rdbvh_benches::{bounds, load_scene, single_thread_pool, RdbvhReuse, BENCH_SCENES};
+use rdbvh_core::build::{BuildArena, Preset, PresetOptions};
+use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
+use rdbvh_core::influence::InfluenceArea;
 
-fn bench_library<L: Library>(group: &mut criterion::BenchmarkGroup<'_, Clock>, tris: &[Triangle]) {
+/// The single-threaded build, measured on the pool's one thread (where the clock is read).
+fn bench_library<L: Library>(
+    group: &mut BenchmarkGroup<'_, Clock>,
+    pool: &rayon::ThreadPool,
+    tris: &[Triangle],
+) where
+    L::Scene: Send,
+    L::Accel: Send,
+{
     let mut scene = L::scene(tris);
     group.bench_function(L::NAME, |b| {
-        b.iter_with_large_drop(|| L::build(black_box(&mut scene)))
+        pool.install(|| b.iter_with_large_drop(|| L::build(black_box(&mut scene))))
     });
+}
+
+/// The threaded build on the global rayon pool (every core); libraries without one are skipped.
+fn bench_library_mt<L: Library, M: Measurement>(
+    group: &mut BenchmarkGroup<'_, M>,
+    tris: &[Triangle],
+) {
+    if L::PARALLEL_BUILD.is_none() {
+        return;
+    }
+    let mut scene = L::scene(tris);
+    group.bench_function(L::NAME, |b| {
+        b.iter_with_large_drop(|| L::build_mt(black_box(&mut scene)))
+    });
+}
+
+fn configure<M: Measurement>(group: &mut BenchmarkGroup<'_, M>, n: usize) {
+    group
+        .throughput(Throughput::Elements(n as u64))
+        // Builds take tens to hundreds of milliseconds: flat sampling keeps ten samples
+        // within the time budget instead of criterion's growing iteration counts.
+        .sampling_mode(SamplingMode::Flat)
+        .sample_size(10)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(3));
 }
 
 fn builds(c: &mut Criterion<Clock>) {
@@ -32,26 +76,78 @@ fn builds(c: &mut Criterion<Clock>) {
                 continue;
             }
         };
+        let pool = single_thread_pool();
         let mut group = c.benchmark_group(format!("build/{name}"));
-        group
-            .throughput(Throughput::Elements(tris.len() as u64))
-            // Builds take tens to hundreds of milliseconds: flat sampling keeps ten samples
-            // within the time budget instead of criterion's growing iteration counts.
-            .sampling_mode(SamplingMode::Flat)
-            .sample_size(10)
-            .warm_up_time(Duration::from_secs(1))
-            .measurement_time(Duration::from_secs(3));
-        bench_library::<Rdbvh>(&mut group, &tris);
+        configure(&mut group, tris.len());
+        bench_library::<Rdbvh>(&mut group, &pool, &tris);
         // The allocation-free path: arena and output sized once, reused by every build.
         let mut reuse = RdbvhReuse::with_capacity(tris.len());
         group.bench_function("rdbvh-reuse", |b| {
             b.iter(|| reuse.build(black_box(&tris)).nodes().len())
         });
-        bench_library::<RdbvhWide>(&mut group, &tris);
-        bench_library::<ObvhsBvh2>(&mut group, &tris);
-        bench_library::<ObvhsCwbvh>(&mut group, &tris);
-        bench_library::<BvhCrate>(&mut group, &tris);
-        bench_library::<Parry>(&mut group, &tris);
+        bench_library::<RdbvhWide>(&mut group, &pool, &tris);
+        bench_library::<ObvhsBvh2>(&mut group, &pool, &tris);
+        bench_library::<ObvhsCwbvh>(&mut group, &pool, &tris);
+        bench_library::<BvhCrate>(&mut group, &pool, &tris);
+        bench_library::<Parry>(&mut group, &pool, &tris);
+        group.finish();
+
+        // PAH beside SAH (issue 6: within 1.1x), the `peers` binary's areas over the scene.
+        let b = bounds(&tris);
+        let areas: Vec<(&str, Preset, Option<InfluenceArea>)> = vec![
+            ("sah", Preset::Sah, None),
+            (
+                "full-plane",
+                Preset::Full,
+                plane_area_over(&b).ok().map(Into::into),
+            ),
+            (
+                "full-point",
+                Preset::Full,
+                point_area_over(&b).ok().map(Into::into),
+            ),
+        ];
+        let mut group = c.benchmark_group(format!("build_pah/{name}"));
+        configure(&mut group, tris.len());
+        let options = PresetOptions::default();
+        let mut arena = BuildArena::with_capacity(tris.len());
+        let mut out = Bvh::with_capacity(tris.len());
+        for (id, preset, area) in &areas {
+            if preset.needs_area() && area.is_none() {
+                eprintln!("build_pah/{name}/{id} skipped: no area over the scene");
+                continue;
+            }
+            group.bench_function(*id, |bench| {
+                bench.iter(|| {
+                    arena.load_triangles(&tris).expect("finite triangles");
+                    preset
+                        .build_into(area.as_ref(), &options, &mut arena, &mut out)
+                        .expect("valid preset")
+                        .nodes
+                })
+            });
+        }
+        group.finish();
+    }
+}
+
+/// Threaded builds, wall time (the thread-CPU clock would see one thread's share only).
+fn builds_mt(c: &mut Criterion<WallTime>) {
+    for name in BENCH_SCENES {
+        let tris = match load_scene(name) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!("build_mt benchmarks skipped for {name}: {e}");
+                continue;
+            }
+        };
+        let mut group = c.benchmark_group(format!("build_mt/{name}"));
+        configure(&mut group, tris.len());
+        bench_library_mt::<Rdbvh, _>(&mut group, &tris);
+        bench_library_mt::<RdbvhWide, _>(&mut group, &tris);
+        bench_library_mt::<ObvhsBvh2, _>(&mut group, &tris);
+        bench_library_mt::<ObvhsCwbvh, _>(&mut group, &tris);
+        bench_library_mt::<BvhCrate, _>(&mut group, &tris);
         group.finish();
     }
 }
@@ -61,4 +157,9 @@ criterion_group! {
     config = Criterion::default().with_measurement(Clock::from_env());
     targets = builds
 }
-criterion_main!(benches);
+criterion_group! {
+    name = benches_mt;
+    config = Criterion::default();
+    targets = builds_mt
+}
+criterion_main!(benches, benches_mt);

@@ -173,17 +173,38 @@ impl Aabb {
     ///
     /// The near plane of each axis is chosen from the sign of the inverse direction, so no per-axis
     /// min/max is needed. A zero direction component gives an infinite inverse; an origin exactly on
-    /// that slab's boundary then gives `0 * inf = NaN` for one plane, and the NaN-ignoring
-    /// `f32::max`/`f32::min` reduction drops it, which is the right answer (the ray runs along the
+    /// that slab's boundary then gives `0 * inf = NaN` for one plane, and the reduction, which keeps
+    /// its accumulator when a value is NaN, drops it: the right answer (the ray runs along the
     /// face).
     #[inline]
     pub fn slab_interval(&self, ray: &Ray, t_max: f32) -> (f32, f32) {
         let (near, far) = ray.near_far(self);
         let tn = (near - ray.origin) * ray.inv_dir;
         let tf = (far - ray.origin) * ray.inv_dir;
-        let t_near = ray.t_min.max(tn.x).max(tn.y).max(tn.z);
-        let t_far = t_max.min(tf.x).min(tf.y).min(tf.z);
+        let t_near = max_keep(max_keep(max_keep(ray.t_min, tn.x), tn.y), tn.z);
+        let t_far = min_keep(min_keep(min_keep(t_max, tf.x), tf.y), tf.z);
         (t_near - t_near.abs() * SLAB_PAD, pad_far(t_far))
+    }
+}
+
+/// `max(acc, t)` that keeps `acc` when `t` is NaN: one `maxss`, where `f32::max` needs extra
+/// instructions to be NaN-symmetric. The accumulator is never NaN.
+#[inline(always)]
+fn max_keep(acc: f32, t: f32) -> f32 {
+    if t > acc {
+        t
+    } else {
+        acc
+    }
+}
+
+/// `min(acc, t)` that keeps `acc` when `t` is NaN.
+#[inline(always)]
+fn min_keep(acc: f32, t: f32) -> f32 {
+    if t < acc {
+        t
+    } else {
+        acc
     }
 }
 

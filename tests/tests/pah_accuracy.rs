@@ -126,7 +126,7 @@ fn perspective_pah_holds_at_130_degrees_for_both_measures() {
     let Some(shared) = require_shared() else {
         return;
     };
-    let scene = Scene::load(&shared.join("scenes/thesis/WoodScene.obj")).unwrap();
+    let scene = Scene::load(shared.join("scenes/thesis/WoodScene.obj")).unwrap();
     let area: InfluenceArea = PointArea::new(
         [0.1, 4.0, 0.2].into(),
         [0.0, -1.0, 0.05].into(),

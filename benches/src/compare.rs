@@ -220,6 +220,10 @@ pub struct Report {
     pub rows: Vec<Row>,
     /// PAH against SAH, when measured.
     pub pah: Option<PahBuilds>,
+    /// rdbvh's serial top of the threaded build (`Builder::build_top`, loading the arena
+    /// included) and its whole single-threaded build, CPU seconds: the serial share bounds the
+    /// threaded build's scaling (Amdahl) whatever the machine's load.
+    pub serial_top: (Timing, Timing),
 }
 
 fn load_average() -> String {
@@ -396,6 +400,7 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         measure::<BvhCrate>(tris, &sets, opts, &one, &all)?,
         measure::<Parry>(tris, &sets, opts, &one, &all)?,
     ];
+    let serial_top = measure_serial_top(tris, opts, all.current_num_threads());
     let pah = if opts.pah {
         Some(measure_pah(tris, &b, opts)?)
     } else {
@@ -414,7 +419,29 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         runs,
         rows,
         pah,
+        serial_top,
     })
+}
+
+/// The serial part of `rdbvh::parallel::build` (the top of the tree down to its job cutoff, the
+/// same rule: 16 jobs per thread, at least 2048 primitives) beside the whole one-thread build.
+fn measure_serial_top(tris: &[Triangle], opts: &Options, threads: usize) -> (Timing, Timing) {
+    let cutoff = ((tris.len() / (threads.max(1) * 16)) as u32).max(2048);
+    let mut arena = BuildArena::with_capacity(tris.len());
+    let mut top = Bvh::with_capacity(tris.len());
+    let mut jobs = Vec::new();
+    let builder = Builder::sah();
+    let serial = best_of(opts, || {
+        arena.load_triangles(tris).is_ok()
+            && builder
+                .build_top(&mut arena, &mut top, cutoff, &mut jobs)
+                .is_ok()
+    });
+    let mut out = Bvh::with_capacity(tris.len());
+    let whole = best_of(opts, || {
+        arena.load_triangles(tris).is_ok() && builder.build_into(&mut arena, &mut out).is_ok()
+    });
+    (serial, whole)
 }
 
 /// Millions per second from a count and a timing, by the clock the measure reports.
@@ -590,6 +617,19 @@ impl Report {
             "rdbvh build scaling, {} threads vs 1 (wall/wall): {:.2}x",
             self.threads,
             self.rdbvh_scaling()
+        );
+        let (top, whole) = &self.serial_top;
+        let f = (top.cpu / whole.cpu.max(1e-12)).min(1.0);
+        let p = self.threads.max(1) as f64;
+        let _ = writeln!(
+            w,
+            "rdbvh threaded build: serial top (load + build_top) {:.1} ms of a {:.1} ms 1-thread \
+             build ({:.0}%): Amdahl bound on {} threads {:.2}x",
+            1e3 * top.cpu,
+            1e3 * whole.cpu,
+            100.0 * f,
+            self.threads,
+            1.0 / (f + (1.0 - f) / p)
         );
         let _ = writeln!(w);
         let _ = writeln!(

@@ -1,0 +1,87 @@
+//! Build with every preset and both builders over arbitrary triangles, then check the tree
+//! invariants and every traversal (binary and 4-wide) against brute force.
+#![no_main]
+
+use arbitrary::{Result, Unstructured};
+use libfuzzer_sys::fuzz_target;
+use rdbvh_core::build::{BuildArena, Builder, Preset};
+use rdbvh_core::bvh::{Bvh, WideBvh, MAX_DEPTH};
+use rdbvh_core::geometry::{Ray, Triangle};
+use rdbvh_core::influence::{InfluenceArea, PlaneArea};
+use rdbvh_core::Vec3;
+use rdbvh_fuzz::*;
+
+fuzz_target!(|data: &[u8]| {
+    let _ = run(&mut Unstructured::new(data));
+});
+
+fn run(u: &mut Unstructured) -> Result<()> {
+    let finite = u.int_in_range(0u8..=7)? != 0;
+    let tris = scene(u, finite)?;
+    let expect_err = expected_build_error(&tris);
+    let area = area(u, &tris)?.unwrap_or_else(|| {
+        PlaneArea::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 5.0, 5.0, 20.0)
+            .unwrap()
+            .into()
+    });
+    let rays: Vec<Ray> = rays(u, &tris, MAX_RAYS)?
+        .into_iter()
+        .filter_map(|r| r.ok())
+        .collect();
+
+    let mut built: Vec<(String, Bvh, u32)> = Vec::new();
+    for round in 0..2 {
+        let config = build_config(u)?;
+        let (name, result) = if round == 0 {
+            ("sah", Builder::sah().with_config(config).build(&tris))
+        } else {
+            ("lsph", Builder::lsph().with_config(config).build(&tris))
+        };
+        match (result, expect_err) {
+            (Ok(bvh), None) => built.push((format!("{name} {config:?}"), bvh, config.max_depth)),
+            (Err(e), Some(x)) => assert_eq!(e, x, "{name}"),
+            (r, x) => panic!(
+                "{name} {config:?}: got {:?}, expected error {x:?}",
+                r.map(|_| ())
+            ),
+        }
+    }
+
+    let options = preset_options(u)?;
+    let mut arena = BuildArena::with_capacity(tris.len());
+    let loaded = arena.load_triangles(&tris);
+    assert_eq!(loaded.err(), expect_err, "arena load");
+    if loaded.is_ok() {
+        for preset in Preset::ALL {
+            let mut bvh = Bvh::with_capacity(tris.len());
+            let area: Option<&InfluenceArea> = Some(&area);
+            let stats = preset.build_into(area, &options, &mut arena, &mut bvh);
+            if let Err(e) = stats {
+                panic!(
+                    "preset {preset} {options:?} over {} triangles: {e}",
+                    tris.len()
+                );
+            }
+            built.push((format!("{preset} {options:?}"), bvh, MAX_DEPTH));
+        }
+    }
+
+    for (what, bvh, max_depth) in &built {
+        check_tree(bvh, &tris, *max_depth, what);
+        let wide = WideBvh::from_binary(bvh);
+        assert!(wide.max_depth() <= MAX_DEPTH, "{what}: wide depth");
+        for ray in &rays {
+            check_queries(bvh, &wide, &tris, ray, what);
+        }
+    }
+    // An empty scene hits nothing, whatever the ray.
+    if tris.is_empty() {
+        let empty: &[Triangle] = &[];
+        for (_, bvh, _) in &built {
+            for ray in &rays {
+                assert_eq!(bvh.closest_hit(ray, empty), None);
+            }
+        }
+    }
+    Ok(())
+}

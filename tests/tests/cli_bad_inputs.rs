@@ -1,0 +1,194 @@
+//! The bad-input catalogue through the `rdbvh` binary: each bad input exits non-zero with one
+//! readable `error: ...` line on standard error, never a panic.
+//!
+//! `env!("CARGO_BIN_EXE_rdbvh")` exists only in std-host's own tests, so this finds the binary
+//! beside the test executable (`target/<profile>/deps/cli_bad_inputs-*` -> `target/<profile>/rdbvh`).
+//! `cargo test --workspace` (the test command) builds it, since std-host's tests need it too. When
+//! it is missing (`cargo test -p rdbvh-tests` alone on a fresh target) the tests print a skip,
+//! and fail under `CI=true`.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use rdbvh_tests::in_ci;
+
+fn binary() -> Option<PathBuf> {
+    let exe = std::env::current_exe().ok()?;
+    let dir = exe.parent()?.parent()?;
+    let bin = dir.join(format!("rdbvh{}", std::env::consts::EXE_SUFFIX));
+    if bin.is_file() {
+        return Some(bin);
+    }
+    assert!(
+        !in_ci(),
+        "CI=true but {} is missing: run cargo test --workspace",
+        bin.display()
+    );
+    println!(
+        "skipped: {} not built (run cargo test --workspace)",
+        bin.display()
+    );
+    None
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("rdbvh-bad-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Runs `rdbvh args`, expects failure with exactly one `error: ` line containing `needle`.
+fn fails(bin: &Path, args: &[&str], needle: &str) {
+    let out = Command::new(bin).args(args).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} succeeded: {stderr}");
+    assert_ne!(out.status.code(), Some(101), "{args:?} panicked: {stderr}");
+    let lines: Vec<&str> = stderr
+        .lines()
+        .filter(|l| !l.starts_with("warning:"))
+        .collect();
+    assert_eq!(lines.len(), 1, "{args:?}: not one line: {stderr}");
+    assert!(lines[0].starts_with("error: "), "{args:?}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    assert!(
+        lines[0].to_lowercase().contains(&needle.to_lowercase()),
+        "{args:?}: {:?} lacks {needle:?}",
+        lines[0]
+    );
+}
+
+#[test]
+fn bad_scenes_are_one_line_errors() {
+    let Some(bin) = binary() else { return };
+    let dir = scratch("scenes");
+    let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    for (name, text, needle) in [
+        ("empty.obj", String::new(), "no triangles"),
+        ("nofaces.obj", tri.to_string(), "no triangles"),
+        ("missing.obj", format!("{tri}f 1 2 7\n"), "line 4"),
+        ("negative.obj", format!("{tri}f -1 -2 -9\n"), "line 4"),
+        (
+            "huge.obj",
+            format!("{tri}f 1 2 99999999999999999999\n"),
+            "huge.obj",
+        ),
+        (
+            "nan.obj",
+            "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".into(),
+            "NaN or infinite",
+        ),
+        (
+            "inf.obj",
+            "v 0 0 inf\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".into(),
+            "NaN or infinite",
+        ),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let p = path.to_str().unwrap();
+        fails(&bin, &["build", p], needle);
+        fails(&bin, &["build", p, "--json"], needle);
+    }
+    fails(
+        &bin,
+        &["build", dir.join("absent.obj").to_str().unwrap()],
+        "absent.obj",
+    );
+    fails(&bin, &["build", "builtin:nope"], "builtin:nope");
+}
+
+#[test]
+fn bad_rays_are_one_line_errors_and_empty_segments_miss() {
+    let Some(bin) = binary() else { return };
+    let dir = scratch("rays");
+    let out = dir.join("hits.csv");
+    let out = out.to_str().unwrap();
+    for (name, rows, needle) in [
+        ("zero.csv", "0,0,0,0,0,0\n", "line 2"),
+        ("nan.csv", "0,0,0,nan,0,1\n", "line 2"),
+        ("nanorigin.csv", "nan,0,0,0,0,1\n", "line 2"),
+        ("short.csv", "0,0,0,0,0\n", "line 2"),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, format!("ox,oy,oz,dx,dy,dz\n{rows}")).unwrap();
+        fails(
+            &bin,
+            &[
+                "trace",
+                "builtin:room",
+                "--rays",
+                path.to_str().unwrap(),
+                "--out",
+                out,
+            ],
+            needle,
+        );
+    }
+    // tmin > tmax: a valid, empty segment that hits nothing.
+    let path = dir.join("empty_segment.csv");
+    std::fs::write(
+        &path,
+        "ox,oy,oz,dx,dy,dz,tmin,tmax\n5,5,5,0,-1,0,10,1\n5,5,5,0,-1,0,0,inf\n",
+    )
+    .unwrap();
+    let run = Command::new(&bin)
+        .args([
+            "trace",
+            "builtin:room",
+            "--rays",
+            path.to_str().unwrap(),
+            "--out",
+            out,
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let hits = std::fs::read_to_string(out).unwrap();
+    let rows: Vec<&str> = hits.lines().collect();
+    assert_eq!(rows[0], "ray,t,triangle,u,v");
+    assert_eq!(rows[1], "0,,,,", "the empty segment misses");
+    assert!(rows[2].len() > 5, "the full ray hits the room: {hits}");
+}
+
+#[test]
+fn bad_areas_are_one_line_errors() {
+    let Some(bin) = binary() else { return };
+    let dir = scratch("areas");
+    let plane = |hw: &str| {
+        format!(
+            "[[area]]\nkind = \"plane\"\ncenter = [5.0, 9.9, 5.0]\nnormal = [0.0, -1.0, 0.0]\n\
+             half_width = {hw}\nhalf_height = 1.0\ndepth = 9.9\n"
+        )
+    };
+    let point = |fov: &str, near: &str| {
+        format!(
+            "[[area]]\nkind = \"point\"\neye = [5.0, 9.0, 5.0]\ndirection = [0.0, -1.0, 0.0]\n\
+             fov_x_deg = {fov}\nfov_y_deg = 60.0\nnear = {near}\nfar = 10.0\n"
+        )
+    };
+    for (name, text, needle) in [
+        ("zero.toml", plane("0.0"), "half_width"),
+        ("negative.toml", plane("-1.0"), "half_width"),
+        ("nan.toml", plane("nan"), "half_width"),
+        ("fov0.toml", point("0.0", "0.1"), "fov_x_deg"),
+        ("fov180.toml", point("180.0", "0.1"), "fov_x_deg"),
+        ("nearfar.toml", point("60.0", "20.0"), "near"),
+        (
+            "garbage.toml",
+            "[[area]\nkind = ".to_string(),
+            "garbage.toml",
+        ),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        fails(
+            &bin,
+            &["build", "builtin:room", "--areas", path.to_str().unwrap()],
+            needle,
+        );
+    }
+}

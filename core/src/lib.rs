@@ -33,5 +33,8 @@ pub mod random;
 pub mod simd;
 pub mod toplevel;
 
+#[cfg(test)]
+mod test_scenes;
+
 pub use error::BuildError;
 pub use glam::Vec3;

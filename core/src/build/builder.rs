@@ -705,29 +705,8 @@ mod tests {
     use crate::geometry::Ray;
     use crate::heuristics::LeafSize;
 
-    /// A xorshift generator: enough for test scenes, and no dependency.
-    struct Xorshift(u64);
-
-    impl Xorshift {
-        fn next_f32(&mut self) -> f32 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 40) as f32 / (1u64 << 24) as f32
-        }
-        fn vec3(&mut self, scale: f32) -> Vec3 {
-            Vec3::new(self.next_f32(), self.next_f32(), self.next_f32()) * scale
-        }
-    }
-
     fn soup(n: usize, seed: u64) -> Vec<Triangle> {
-        let mut rng = Xorshift(seed);
-        (0..n)
-            .map(|_| {
-                let v0 = rng.vec3(10.0);
-                Triangle::new(v0, v0 + rng.vec3(1.0), v0 + rng.vec3(1.0))
-            })
-            .collect()
+        crate::test_scenes::soup(n, seed, 0.0, 10.0, 1.0)
     }
 
     fn check_against_brute_force<A: AxisChooser, C: CostModel, T: Termination>(
@@ -737,10 +716,11 @@ mod tests {
         let bvh = builder.build(tris).unwrap();
         bvh.validate(tris.len(), |i| tris[i as usize].bounds())
             .unwrap();
-        let mut rng = Xorshift(99);
+        let mut rng = crate::random::Pcg32::new(99);
+        let mut v = |a: f32, b: f32| Vec3::new(rng.range(a, b), rng.range(a, b), rng.range(a, b));
         for _ in 0..300 {
-            let o = rng.vec3(12.0) - Vec3::ONE;
-            let d = rng.vec3(2.0) - Vec3::ONE;
+            let o = v(-1.0, 11.0);
+            let d = v(-1.0, 1.0);
             let Ok(ray) = Ray::new(o, d) else { continue };
             let expect = brute_force::closest_hit(&ray, tris);
             assert_eq!(bvh.closest_hit(&ray, tris), expect);

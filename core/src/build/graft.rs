@@ -113,23 +113,12 @@ fn canonical_order(nodes: &[BvhNode]) -> Vec<BvhNode> {
 mod tests {
     use alloc::vec::Vec;
 
-    use glam::Vec3;
-
     use super::*;
     use crate::build::{BuildArena, Builder};
-    use crate::geometry::Triangle;
-    use crate::random::Pcg32;
 
     #[test]
     fn grafted_tree_equals_single_threaded_tree() {
-        let mut rng = Pcg32::new(8);
-        let mut v = |s: f32| Vec3::new(rng.range(-s, s), rng.range(-s, s), rng.range(-s, s));
-        let tris: Vec<Triangle> = (0..3000)
-            .map(|_| {
-                let a = v(10.0);
-                Triangle::new(a, a + v(0.5), a + v(0.5))
-            })
-            .collect();
+        let tris = crate::test_scenes::soup(3000, 8, -10.0, 10.0, 0.5);
         let builder = Builder::sah();
         let whole = builder.build(&tris).unwrap();
         for cutoff in [1, 7, 100, 1000, 5000] {

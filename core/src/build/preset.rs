@@ -341,27 +341,9 @@ mod tests {
     use crate::brute_force;
     use crate::geometry::Triangle;
     use crate::influence::{PlaneArea, PointArea, RaySampler};
-    use crate::random::Pcg32;
 
     fn soup(n: usize) -> Vec<Triangle> {
-        let mut rng = Pcg32::new(1);
-        let mut v = || {
-            Vec3::new(
-                rng.range(0.0, 10.0),
-                rng.range(0.0, 10.0),
-                rng.range(0.0, 10.0),
-            )
-        };
-        (0..n)
-            .map(|_| {
-                let a = v();
-                Triangle::new(
-                    a,
-                    a + (v() - Vec3::splat(5.0)) * 0.2,
-                    a + (v() - Vec3::splat(5.0)) * 0.2,
-                )
-            })
-            .collect()
+        crate::test_scenes::soup(n, 1, 0.0, 10.0, 1.0)
     }
 
     #[test]

@@ -390,24 +390,7 @@ mod tests {
     use crate::random::Pcg32;
 
     fn soup(n: usize, seed: u64) -> Vec<Triangle> {
-        let mut rng = Pcg32::new(seed);
-        let mut v = || {
-            Vec3::new(
-                rng.range(0.0, 10.0),
-                rng.range(0.0, 10.0),
-                rng.range(0.0, 10.0),
-            )
-        };
-        (0..n)
-            .map(|_| {
-                let a = v();
-                Triangle::new(
-                    a,
-                    a + (v() - Vec3::splat(5.0)) * 0.3,
-                    a + (v() - Vec3::splat(5.0)) * 0.3,
-                )
-            })
-            .collect()
+        crate::test_scenes::soup(n, seed, 0.0, 10.0, 1.5)
     }
 
     fn areas() -> Vec<InfluenceArea> {

@@ -18,6 +18,7 @@ use rdbvh_core::build::{BuildArena, Builder};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 
+pub mod areas;
 pub mod compare;
 pub mod peers;
 

@@ -112,6 +112,16 @@ impl Polytope {
         1e-5 * self.scale.max(other_scale).max(1e-30)
     }
 
+    /// True when every corner, plane and axis is finite (inputs near `f32::MAX` can overflow).
+    pub fn is_finite(&self) -> bool {
+        self.vertices.iter().all(|v| v.is_finite())
+            && self
+                .planes
+                .iter()
+                .all(|p| p.normal.is_finite() && p.offset.is_finite())
+            && self.scale.is_finite()
+    }
+
     /// True when `p` is inside (boundary included, with the same relative tolerance).
     #[inline]
     pub fn contains(&self, p: Vec3) -> bool {

@@ -20,7 +20,13 @@ impl Frame {
     /// up, `right` is taken as `normalize(f x (0, 0, 1))`, a fixed choice so the frame is still
     /// deterministic. `None` when `dir` is zero or not finite.
     pub fn look_at(dir: Vec3) -> Option<Frame> {
-        let forward = dir.try_normalize()?;
+        // Scaled by its largest component first: the squared length of a tiny direction (1e-22)
+        // is subnormal, and normalising it directly gives a vector far from unit length.
+        let largest = dir.abs().max_element();
+        if !(largest > 0.0 && largest.is_finite()) {
+            return None;
+        }
+        let forward = (dir / largest).try_normalize()?;
         let right = forward
             .cross(Vec3::Y)
             .try_normalize()
@@ -72,6 +78,9 @@ mod tests {
         assert!((f.right - Vec3::NEG_X).length() < 1e-6);
         assert!((f.up - Vec3::Y).length() < 1e-6);
         assert!(Frame::look_at(Vec3::ZERO).is_none());
+        let tiny = Frame::look_at(Vec3::new(0.0, -4.5e-23, 1e-24)).unwrap();
+        assert!((tiny.forward.length() - 1.0).abs() < 1e-6);
+        assert!((tiny.right.length() - 1.0).abs() < 1e-6);
         assert!(Frame::look_at(Vec3::new(f32::NAN, 0.0, 1.0)).is_none());
     }
 }

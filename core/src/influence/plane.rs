@@ -48,6 +48,11 @@ impl PlaneArea {
             Vec3::new(half_width, half_height, 0.5 * depth),
         )
         .ok_or(AreaError::NotFinite("center"))?;
+        let polytope = obb.polytope();
+        if !polytope.is_finite() {
+            // Finite inputs near f32::MAX can still overflow the box's corners and planes.
+            return Err(AreaError::NotFinite("center"));
+        }
         Ok(Self {
             center,
             frame,
@@ -55,7 +60,7 @@ impl PlaneArea {
             half_height,
             depth,
             obb,
-            polytope: obb.polytope(),
+            polytope,
             cos_tolerance: cos_tolerance(DEFAULT_AFFINITY_DEG)?,
         })
     }

@@ -55,11 +55,16 @@ impl PointArea {
         }
         let frustum =
             Frustum::new(eye, frame, tan_x, tan_y, near, far).ok_or(AreaError::NearFar)?;
+        let polytope = frustum.polytope();
+        if !polytope.is_finite() {
+            // Finite inputs near f32::MAX can still overflow the frustum's corners and planes.
+            return Err(AreaError::NotFinite("eye"));
+        }
         Ok(Self {
             fov_x_deg,
             fov_y_deg,
             frustum,
-            polytope: frustum.polytope(),
+            polytope,
             cos_tolerance: cos_tolerance(DEFAULT_AFFINITY_DEG)?,
         })
     }

@@ -18,9 +18,9 @@ mod rays;
 mod structure;
 mod trace;
 
+pub use analyze::{AnalyzeArgs, NODE_COLUMNS};
 pub use build::{BuildArgs, BuildReport};
 pub use builder::{chooser_name, BuilderArgs, BuilderKind, BuiltBvh, PresetArg};
-pub use analyze::{AnalyzeArgs, NODE_COLUMNS};
 pub use error::CliError;
 pub use experiment::ExperimentArgs;
 pub use rays::{parse_rays, read_rays, RaysError, OPTIONAL_COLUMNS, REQUIRED_COLUMNS};

@@ -9,6 +9,7 @@
 
 pub mod areas;
 pub mod cli;
+pub mod clock;
 pub mod experiment;
 pub mod parallel;
 pub mod scene;

@@ -2,6 +2,7 @@
 
 use super::arena::{Bin, BuildArena, PrimRefs, Sweep, Task};
 use super::config::{BinSpace, BuildConfig, CutEvaluation};
+use super::profile::{Clock, NoClock, PhaseProfile};
 use crate::bvh::{Bvh, BvhNode};
 use alloc::vec::Vec;
 
@@ -39,6 +40,8 @@ pub struct BuildStats {
     /// Nodes split by the object-median fallback because the heuristic could not separate them
     /// (all centroids equal, a zero-measure node) or the depth budget ran short.
     pub median_splits: u32,
+    /// Time and calls of the orientation choice and the candidate pricing.
+    pub profile: PhaseProfile,
 }
 
 /// A top-down binned builder (Wald 2007) with pluggable axis choice `A`, cost model `C` and
@@ -190,7 +193,17 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         arena: &mut BuildArena,
         out: &mut Bvh,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, 0, 0, None)
+        self.build_range(arena, out, 0, 0, None, &NoClock)
+    }
+
+    /// [`Builder::build_into`], timing its phases with `clock` into [`BuildStats::profile`].
+    pub fn build_into_profiled(
+        &self,
+        arena: &mut BuildArena,
+        out: &mut Bvh,
+        clock: &impl Clock,
+    ) -> Result<BuildStats, BuildError> {
+        self.build_range(arena, out, 0, 0, None, clock)
     }
 
     /// [`Builder::build_into`] for a subtree whose root sits at depth `depth` of a larger tree, so
@@ -202,7 +215,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         out: &mut Bvh,
         depth: u32,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, depth, 0, None)
+        self.build_range(arena, out, depth, 0, None, &NoClock)
     }
 
     /// The top of a build, for threaded builders: like [`Builder::build_into`], but a node of at
@@ -218,7 +231,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         jobs: &mut Vec<Subtree>,
     ) -> Result<BuildStats, BuildError> {
         jobs.clear();
-        self.build_range(arena, out, 0, cutoff, Some(jobs))
+        self.build_range(arena, out, 0, cutoff, Some(jobs), &NoClock)
     }
 
     fn build_range(
@@ -228,6 +241,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         depth: u32,
         cutoff: u32,
         mut jobs: Option<&mut Vec<Subtree>>,
+        clock: &impl Clock,
     ) -> Result<BuildStats, BuildError> {
         self.config.validate()?;
         let n = arena.len();
@@ -268,7 +282,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             let decided = if deferred {
                 None
             } else {
-                self.split(arena, &task, &task.bounds, &mut stats)
+                self.split(arena, &task, &task.bounds, &mut stats, clock)
             };
             match decided {
                 None => stats.leaves += u32::from(!deferred),
@@ -318,6 +332,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         task: &Task,
         bounds: &Aabb,
         stats: &mut BuildStats,
+        clock: &impl Clock,
     ) -> Option<(Child, Child)> {
         let count = task.count;
         if task.depth >= self.config.max_depth || count <= 1 {
@@ -333,14 +348,22 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         }
         let parent = self.cost.measure(bounds);
         let chosen = if parent > 0.0 && parent.is_finite() {
-            self.choose(&self.cost, parent, arena, task, bounds)
-                .map(|s| (s, s.weighted_under(&self.cost) / parent))
+            self.choose(
+                &self.cost,
+                parent,
+                arena,
+                task,
+                bounds,
+                &mut stats.profile,
+                clock,
+            )
+            .map(|s| (s, s.weighted_under(&self.cost) / parent))
         } else {
             // No modelled ray reaches this node (a PAH node outside the light window): SAH, the
             // uniform-ray model, still orders its subtree sensibly for every other ray.
             let parent = Sah.measure(bounds);
             (parent > 0.0 && parent.is_finite())
-                .then(|| self.choose(&Sah, parent, arena, task, bounds))
+                .then(|| self.choose(&Sah, parent, arena, task, bounds, &mut stats.profile, clock))
                 .flatten()
                 .map(|s| (s, s.weighted / parent))
         };
@@ -376,6 +399,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
     }
 
     /// Bins the node along the axes the cut evaluation needs, then applies it with `model`.
+    #[allow(clippy::too_many_arguments)]
     fn choose<M: CostModel>(
         &self,
         model: &M,
@@ -383,8 +407,13 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         arena: &mut BuildArena,
         task: &Task,
         bounds: &Aabb,
+        profile: &mut PhaseProfile,
+        clock: &impl Clock,
     ) -> Option<Split> {
+        let t0 = clock.now_ns();
         let order = self.axes.order(bounds);
+        profile.choose_ns += clock.now_ns() - t0;
+        profile.choose_calls += 1;
         let first = order.iter().next()?.0;
         let mut binned = [false; 3];
         match self.config.cut {
@@ -397,8 +426,13 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         let maps = self.bin(arena, task, bounds, binned, nb);
         let nb = nb as usize;
         let BuildArena { bins, sweep, .. } = arena;
-        let mut sweep_axis =
-            |axis: usize, model: &M| sweep_axis(&bins[axis][..nb], sweep, axis, maps[axis]?, model);
+        let mut sweep_axis = |axis: usize, model: &M| {
+            let t0 = clock.now_ns();
+            let split = sweep_axis(&bins[axis][..nb], sweep, axis, maps[axis]?, model);
+            profile.cost_ns += clock.now_ns() - t0;
+            profile.cost_calls += 1;
+            split
+        };
         match self.config.cut {
             CutEvaluation::BestOfAxes => {
                 let mut best: Option<Split> = None;
@@ -432,9 +466,13 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                     // Not even acceptable: SAH on the longest axis, the thesis's fallback.
                     _ => {
                         let axis = bounds.largest_axis();
-                        maps[axis]
-                            .and_then(|m| self::sweep_axis(&bins[axis][..nb], sweep, axis, m, &Sah))
-                            .or(best)
+                        let t0 = clock.now_ns();
+                        let fallback = maps[axis].and_then(|m| {
+                            self::sweep_axis(&bins[axis][..nb], sweep, axis, m, &Sah)
+                        });
+                        profile.cost_ns += clock.now_ns() - t0;
+                        profile.cost_calls += 1;
+                        fallback.or(best)
                     }
                 }
             }

@@ -10,9 +10,11 @@ mod builder;
 mod config;
 mod graft;
 mod preset;
+mod profile;
 
 pub use arena::BuildArena;
 pub use builder::{BuildStats, Builder, Subtree};
 pub use config::{BinSpace, BuildConfig, CutEvaluation, ThesisCut, MAX_BINS};
 pub use graft::GraftError;
 pub use preset::{AreaPah, Preset, PresetError, PresetOptions};
+pub use profile::{Clock, NoClock, PhaseProfile};

@@ -2,7 +2,10 @@
 
 use core::fmt;
 
-use super::{BinSpace, BuildArena, BuildConfig, BuildStats, Builder, CutEvaluation, ThesisCut};
+use super::{
+    BinSpace, BuildArena, BuildConfig, BuildStats, Builder, Clock, CutEvaluation, NoClock,
+    ThesisCut,
+};
 use crate::bvh::{Bvh, MAX_DEPTH};
 use crate::geometry::Aabb;
 use crate::heuristics::{
@@ -236,6 +239,18 @@ impl Preset {
         arena: &mut BuildArena,
         out: &mut Bvh,
     ) -> Result<BuildStats, PresetError> {
+        self.build_into_profiled(area, options, arena, out, &NoClock)
+    }
+
+    /// [`Preset::build_into`], timing its phases with `clock` into [`BuildStats::profile`].
+    pub fn build_into_profiled(
+        self,
+        area: Option<&InfluenceArea>,
+        options: &PresetOptions,
+        arena: &mut BuildArena,
+        out: &mut Bvh,
+        clock: &impl Clock,
+    ) -> Result<BuildStats, PresetError> {
         let lsph = CutEvaluation::Thesis(ThesisCut {
             quality_threshold: options.lsph_quality_threshold,
             ..options.cut
@@ -253,10 +268,17 @@ impl Preset {
                 options.config(CutEvaluation::BestOfAxes),
                 arena,
                 out,
+                clock,
             ),
-            (Preset::Standard, _) => {
-                run(LongestAxis, Sah, options, options.config(lsph), arena, out)
-            }
+            (Preset::Standard, _) => run(
+                LongestAxis,
+                Sah,
+                options,
+                options.config(lsph),
+                arena,
+                out,
+                clock,
+            ),
             (Preset::Facing, Some(a)) => run(
                 Spfh::for_area(a),
                 Sah,
@@ -264,6 +286,7 @@ impl Preset {
                 options.config(spfh),
                 arena,
                 out,
+                clock,
             ),
             (Preset::Longest, Some(InfluenceArea::Plane(a))) => run(
                 LongestAxis,
@@ -272,6 +295,7 @@ impl Preset {
                 options.config(lsph),
                 arena,
                 out,
+                clock,
             ),
             (Preset::Longest, Some(InfluenceArea::Point(a))) => run(
                 LongestAxis,
@@ -280,6 +304,7 @@ impl Preset {
                 options.config(lsph),
                 arena,
                 out,
+                clock,
             ),
             (Preset::Full, Some(area @ InfluenceArea::Plane(a))) => run(
                 Spfh::for_area(area),
@@ -288,6 +313,7 @@ impl Preset {
                 options.config(spfh),
                 arena,
                 out,
+                clock,
             ),
             (Preset::Full, Some(area @ InfluenceArea::Point(a))) => run(
                 Spfh::for_area(area),
@@ -296,6 +322,7 @@ impl Preset {
                 options.config(spfh),
                 arena,
                 out,
+                clock,
             ),
             (_, None) => Err(PresetError::NeedsArea(self)),
         }
@@ -310,24 +337,26 @@ fn run<A: AxisChooser, C: CostModel>(
     config: BuildConfig,
     arena: &mut BuildArena,
     out: &mut Bvh,
+    clock: &impl Clock,
 ) -> Result<BuildStats, PresetError> {
     fn go<A: AxisChooser, C: CostModel, T: Termination>(
         b: Builder<A, C, T>,
         arena: &mut BuildArena,
         out: &mut Bvh,
+        clock: &impl Clock,
     ) -> Result<BuildStats, PresetError> {
-        Ok(b.build_into(arena, out)?)
+        Ok(b.build_into_profiled(arena, out, clock)?)
     }
     if options.thesis_mode {
         let stop = LeafSize {
             max_leaf: options.max_leaf,
         };
-        go(Builder::new(axes, cost, stop, config), arena, out)
+        go(Builder::new(axes, cost, stop, config), arena, out, clock)
     } else {
         let stop = SahTermination {
             max_leaf: options.max_leaf,
         };
-        go(Builder::new(axes, cost, stop, config), arena, out)
+        go(Builder::new(axes, cost, stop, config), arena, out, clock)
     }
 }
 

@@ -21,6 +21,12 @@
 //!   overlap of the two children over the smaller child, in the light's projection, in the
 //!   projection clipped to its window, and in 3D (see `rdbvh_core::analyze::SiblingOverlap`).
 //! - `Max level`: levels of the local BVH (root = level 1).
+//! - `Compute cost PAH average` / `count`: mean microseconds of one axis's sweep (pricing every
+//!   candidate plane on it with the preset's cost model), and sweeps per priced node;
+//!   `Choose split plane PAH average` / `count`: mean microseconds of the axis chooser's
+//!   orientation choice, and choices per inner node (a node priced and then kept as a leaf makes
+//!   one too, so this can exceed 1; median-fallback splits make none). Both from a second build
+//!   of the same BVH with a clock (`PhaseProfile`).
 //! - `EPO`, closest-hit and any-hit costs, rays per second, build milliseconds, memory: see the
 //!   column names; closest-hit and any-hit costs are of real ordered traversals with early exit.
 

@@ -150,7 +150,16 @@ pub fn fields(r: &RunRow) -> Vec<String> {
     v.push(f(r.quality_threshold));
     v.push(f(r.acceptable_ratio));
     v.push(f(r.excellent_ratio));
-    v.extend(std::iter::repeat_n(String::new(), 4));
+    // The thesis's profile columns: mean microseconds per call, and calls per priced node.
+    let p = &m.profile;
+    let per_call = |ns: u64, calls: u64| ns as f64 / 1e3 / calls.max(1) as f64;
+    let per_node = |calls: u64| calls as f64 / p.choose_calls.max(1) as f64;
+    v.extend([
+        format!("{}", per_call(p.cost_ns, p.cost_calls)),
+        format!("{}", per_node(p.cost_calls)),
+        format!("{}", per_call(p.choose_ns, p.choose_calls)),
+        format!("{}", p.choose_calls as f64 / m.shape.inner.max(1) as f64),
+    ]);
     for l in &THESIS_LEVELS[1..] {
         v.push(f(level(&m.overlap_projected, *l)));
     }

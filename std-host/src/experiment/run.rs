@@ -13,6 +13,7 @@ use rdbvh_core::influence::{InfluenceArea, PointDistribution, RaySampler};
 use rdbvh_core::toplevel::{Octree, Scene};
 
 use super::ExperimentError;
+use crate::clock::StdClock;
 
 /// How a run is set up.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,6 +43,9 @@ pub struct RunMetrics {
     pub local_triangles: u32,
     /// Milliseconds to build the local BVH (selection of the area's triangles excluded).
     pub build_ms: f64,
+    /// Phase times and calls of a second, profiled build of the same local BVH (timing every
+    /// phase slows a build, so `build_ms` comes from the unprofiled one).
+    pub profile: rdbvh_core::build::PhaseProfile,
     /// Shape of the local BVH.
     pub shape: rdbvh_core::analyze::ShapeReport,
     /// PAH estimate per ray of the area (over its window measure).
@@ -116,6 +120,22 @@ pub fn run_one(
         .build_into(Some(area), &setup.local, &mut arena, &mut local)
         .map_err(|e| ExperimentError::Build(format!("local BVH ({preset}): {e}")))?;
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
+    let profile = {
+        arena
+            .load_triangle_subset(tris, ids.iter().copied())
+            .map_err(|e| ExperimentError::Build(format!("local BVH: {e}")))?;
+        let mut scratch = Bvh::with_capacity(ids.len());
+        preset
+            .build_into_profiled(
+                Some(area),
+                &setup.local,
+                &mut arena,
+                &mut scratch,
+                &StdClock::new(),
+            )
+            .map_err(|e| ExperimentError::Build(format!("local BVH ({preset}): {e}")))?
+            .profile
+    };
 
     let pah = AreaPah::new(area, setup.local.perspective);
     let window = pah.window_measure();
@@ -164,6 +184,7 @@ pub fn run_one(
     Ok(RunMetrics {
         local_triangles: ids.len() as u32,
         build_ms,
+        profile,
         shape,
         pah: pah_cost.per_ray,
         pah_root: pah_cost.relative_to_root,

@@ -87,7 +87,11 @@ fn run(u: &mut Unstructured) -> Result<()> {
 
     // A constructed area is a finite convex polytope holding its own centre.
     let poly = area.polytope();
-    if area_known_core_bug(&area).is_some() {
+    check_area_sane(&area);
+    if poly.vertices.iter().any(|v| v.abs().max_element() > 1e37) {
+        // CORE BUG (open, `core_bug_area_with_f32_max_depth_misses_its_centre` in
+        // tests/tests/fuzz_regressions.rs): within a factor of 30 of `f32::MAX` the box's own
+        // centre can fall outside it.
         return Ok(());
     }
     assert!(poly.vertices.iter().all(|v| v.is_finite()), "{area:?}");
@@ -117,7 +121,10 @@ fn run(u: &mut Unstructured) -> Result<()> {
             _ => Triangle::new(vec3(u)?, vec3(u)?, vec3(u)?),
         };
         let overlaps = area.overlaps_triangle(&t);
-        if t.is_finite() && !overlaps {
+        // CORE BUG (open, `core_bug_sat_misses_vertex_inside_huge_frustum` in
+        // tests/tests/fuzz_regressions.rs): past 1e20 the SAT rounding exceeds its tolerance.
+        let huge = poly.scale > 1e20 || t.bounds().extent().max_element() > 1e20;
+        if t.is_finite() && !overlaps && !huge {
             for i in 0..=8u8 {
                 for j in 0..=(8 - i) {
                     let (a, b) = (f32::from(i) / 8.0, f32::from(j) / 8.0);
@@ -187,9 +194,9 @@ fn check_message(e: &AreaError) -> Result<()> {
     Ok(())
 }
 
-/// A direction the look-at frame cannot use: zero, or too small (or too large) to normalise.
+/// The zero direction (a tiny one is a valid direction: the frame scales it first).
 fn zero_dir(d: Vec3) -> bool {
-    d.is_finite() && d.try_normalize().is_none()
+    d == Vec3::ZERO
 }
 
 /// When any documented bad value is present (`reasons`), construction fails with one of those
@@ -198,6 +205,17 @@ fn zero_dir(d: Vec3) -> bool {
 fn check_error(err: Option<&AreaError>, reasons: &[Option<&'static str>]) {
     let reasons: Vec<&str> = reasons.iter().flatten().copied().collect();
     if reasons.is_empty() {
+        // Beyond the documented bad values, only derived geometry that overflows (coordinates
+        // near `f32::MAX`) or a frustum too thin to have planes may be rejected.
+        if let Some(e) = err {
+            assert!(
+                matches!(
+                    e,
+                    AreaError::NotFinite(_) | AreaError::FieldOfView(_) | AreaError::NearFar
+                ),
+                "{e:?} with no documented reason"
+            );
+        }
         return;
     }
     let err = err.unwrap_or_else(|| panic!("accepted despite {reasons:?}"));

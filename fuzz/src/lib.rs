@@ -369,31 +369,26 @@ pub fn strictly_inside(area: &InfluenceArea, p: Vec3) -> bool {
             .all(|pl| pl.signed(p) < -1e-4 * scale * pl.normal.length())
 }
 
-/// Which open core bug an accepted influence area runs into, if any, so the targets set such
-/// areas aside by name (each has an ignored `core_bug_*` test in `tests/tests/bad_inputs.rs`):
-/// - `core_bug_area_near_f32_max_overflows`: coordinates near `f32::MAX` make the polytope's
-///   planes or corners infinite (or their dot products overflow), and the area contains nothing, not even its own centre;
-/// - `core_bug_tiny_direction_gives_non_unit_frame`: a direction whose squared length is
-///   subnormal (`|d|` about `1e-22`) normalises to a vector of length far from 1, so the frame is
-///   not orthonormal and the area's own sampled rays are not affine to it.
-pub fn area_known_core_bug(area: &InfluenceArea) -> Option<&'static str> {
+/// Checks what the fixed area bugs broke (`area_near_f32_max_is_an_error` and
+/// `tiny_direction_gives_a_unit_frame` in `tests/tests/bad_inputs.rs`): an accepted area has
+/// finite planes and corners, and an orthonormal frame.
+pub fn check_area_sane(area: &InfluenceArea) {
     let poly = area.polytope();
-    // Within a factor of 30 of `f32::MAX`, a plane's dot product (three terms) can overflow.
-    let finite = poly.vertices.iter().all(|v| v.abs().max_element() < 1e37)
-        && poly
-            .planes
-            .iter()
-            .all(|pl| pl.normal.is_finite() && pl.offset.is_finite());
-    if !finite {
-        return Some("core_bug_area_near_f32_max_overflows");
-    }
+    assert!(
+        poly.vertices.iter().all(|v| v.is_finite())
+            && poly
+                .planes
+                .iter()
+                .all(|pl| pl.normal.is_finite() && pl.offset.is_finite()),
+        "accepted area with non-finite geometry: {area:?}"
+    );
     let frame = match area {
         InfluenceArea::Plane(a) => a.frame,
         InfluenceArea::Point(a) => a.frustum().frame,
     };
     let unit = |v: Vec3| (v.length() - 1.0).abs() < 1e-4;
-    if !(unit(frame.forward) && unit(frame.right) && unit(frame.up)) {
-        return Some("core_bug_tiny_direction_gives_non_unit_frame");
-    }
-    None
+    assert!(
+        unit(frame.forward) && unit(frame.right) && unit(frame.up),
+        "non-unit frame: {area:?}"
+    );
 }

@@ -18,7 +18,14 @@ pub enum AreaError {
     NearFar,
     /// The affinity tolerance is not within `[0, 180)` degrees.
     Tolerance,
+    /// The area reaches farther than [`MAX_AREA_COORDINATE`] from the origin: products of its
+    /// coordinates would overflow `f32`, and its planes would lose the box to rounding.
+    TooLarge(&'static str),
 }
+
+/// How far from the origin an influence area may reach, per coordinate. Its plane offsets and
+/// separating-axis projections multiply coordinates, and `1e18` squared stays well inside `f32`.
+pub const MAX_AREA_COORDINATE: f32 = 1e18;
 
 impl fmt::Display for AreaError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -33,6 +40,11 @@ impl fmt::Display for AreaError {
             AreaError::Tolerance => {
                 f.write_str("the affinity tolerance must be within [0, 180) degrees")
             }
+            AreaError::TooLarge(key) => write!(
+                f,
+                "`{key}` puts the area more than 1e18 units from the origin, beyond what f32 \
+                 geometry can test"
+            ),
         }
     }
 }

@@ -3,7 +3,7 @@
 use glam::Vec3;
 
 use super::error::{cos_tolerance, finite3, positive};
-use super::{AreaError, DEFAULT_AFFINITY_DEG};
+use super::{AreaError, DEFAULT_AFFINITY_DEG, MAX_AREA_COORDINATE};
 use crate::geometry::{Aabb, Frame, Obb, Polytope, Ray, Triangle};
 
 /// An oriented box: the light rectangle (centre `center`, half extents `half_width` along
@@ -52,6 +52,14 @@ impl PlaneArea {
         if !polytope.is_finite() {
             // Finite inputs near f32::MAX can still overflow the box's corners and planes.
             return Err(AreaError::NotFinite("center"));
+        }
+        if polytope.scale > MAX_AREA_COORDINATE {
+            let key = if depth > half_width.max(half_height) {
+                "depth"
+            } else {
+                "center"
+            };
+            return Err(AreaError::TooLarge(key));
         }
         Ok(Self {
             center,

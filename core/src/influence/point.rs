@@ -3,7 +3,7 @@
 use glam::Vec3;
 
 use super::error::{cos_tolerance, finite3};
-use super::{AreaError, DEFAULT_AFFINITY_DEG};
+use super::{AreaError, DEFAULT_AFFINITY_DEG, MAX_AREA_COORDINATE};
 use crate::geometry::{Aabb, Frame, Frustum, Polytope, Ray, Triangle};
 
 /// A frustum with apex at the light (`eye`), looking along `frame.forward`, full fields of view
@@ -59,6 +59,9 @@ impl PointArea {
         if !polytope.is_finite() {
             // Finite inputs near f32::MAX can still overflow the frustum's corners and planes.
             return Err(AreaError::NotFinite("eye"));
+        }
+        if polytope.scale > MAX_AREA_COORDINATE {
+            return Err(AreaError::TooLarge("far"));
         }
         Ok(Self {
             fov_x_deg,

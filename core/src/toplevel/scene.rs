@@ -194,15 +194,16 @@ impl<L: AreaLookup> Scene<L> {
     }
 
     /// The triangle ids that [`Scene::build`] gives area `area`'s local BVH: those overlapping it,
-    /// by a cheap box test first and the exact separating-axis test then.
+    /// by a cheap box test first and the exact separating-axis test then. The box test uses the
+    /// padded boxes the BVH nodes use, so it never rejects a triangle whose hits a BVH reports.
     pub fn triangles_in_area<'a>(
         area: &'a InfluenceArea,
         tris: &'a [Triangle],
     ) -> impl Iterator<Item = u32> + 'a {
-        let bounds = area.bounds();
+        let bounds = area.bounds().padded();
         (0..tris.len() as u32).filter(move |&t| {
             let tri = &tris[t as usize];
-            !tri.bounds().intersection(bounds).is_empty() && area.overlaps_triangle(tri)
+            !tri.bounds().padded().intersection(bounds).is_empty() && area.overlaps_triangle(tri)
         })
     }
 

@@ -138,15 +138,14 @@ impl fmt::Display for AreasErrorKind {
                 found,
             } => write!(f, "`{key}` must be {expected}, not {found}"),
             AreasErrorKind::UnknownKind(kind) => {
-                write!(
-                    f,
-                    "unknown kind \"{kind}\" (expected \"plane\" or \"point\")"
-                )
+                // Debug-quoted: a value is echoed escaped, so the message stays one line.
+                write!(f, "unknown kind {kind:?} (expected \"plane\" or \"point\")")
             }
             AreasErrorKind::UnknownKey { key, area_kind } => write!(
                 f,
-                "unknown key `{key}` for a {} area (expected kind, {}; scene, file, orientation \
+                "unknown key `{}` for a {} area (expected kind, {}; scene, file, orientation \
                  and thesis_test are allowed and ignored)",
+                key.escape_debug(),
                 area_kind.name(),
                 area_kind.keys().join(", ")
             ),
@@ -154,13 +153,14 @@ impl fmt::Display for AreasErrorKind {
             AreasErrorKind::NoneForScene { scene, files } => {
                 write!(
                     f,
-                    "no [[config]] entry is for scene {scene} (entries are matched by their \
-                     `file` key"
+                    "no [[config]] entry is for scene {} (entries are matched by their \
+                     `file` key",
+                    scene.escape_debug()
                 )?;
                 if files.is_empty() {
                     f.write_str(", and none has one)")
                 } else {
-                    write!(f, "; this file names {})", files.join(", "))
+                    write!(f, "; this file names {})", files.join(", ").escape_debug())
                 }
             }
         }

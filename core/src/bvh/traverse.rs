@@ -326,3 +326,50 @@ impl Bvh {
         stats
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::brute_force;
+    use crate::build::Builder;
+
+    /// The stack's one unsafe read: pops return exactly what was pushed, in reverse, and an
+    /// empty stack pops nothing (small enough for Miri, which the test command runs on it).
+    #[test]
+    fn stack_returns_what_was_pushed() {
+        let mut s: Stack<(u32, f32), 4> = Stack::new();
+        assert_eq!(s.pop(), None);
+        for i in 0..4 {
+            s.push((i, i as f32 * 0.5));
+        }
+        for i in (0..4).rev() {
+            assert_eq!(s.pop(), Some((i, i as f32 * 0.5)));
+        }
+        assert_eq!(s.pop(), None);
+        s.push((9, 1.0));
+        assert_eq!(s.pop(), Some((9, 1.0)));
+    }
+
+    /// Every traversal over a small tree, against brute force: the stacks' whole life cycle.
+    #[test]
+    fn traversals_of_a_small_tree() {
+        let tris = crate::test_scenes::soup(24, 5, 0.0, 4.0, 1.0);
+        let bvh = Builder::sah().build(&tris).unwrap();
+        let wide = crate::bvh::WideBvh::from_binary(&bvh);
+        for i in 0..16 {
+            let o = Vec3::new(-1.0, (i % 4) as f32, (i / 4) as f32);
+            let ray = Ray::new(o, Vec3::new(1.0, 0.1, 0.05)).unwrap();
+            let expect = brute_force::closest_hit(&ray, &tris);
+            assert_eq!(bvh.closest_hit(&ray, &tris), expect);
+            assert_eq!(wide.closest_hit(&ray, &tris), expect);
+            assert_eq!(bvh.any_hit(&ray, &tris), expect.is_some());
+            assert_eq!(wide.any_hit(&ray, &tris), expect.is_some());
+            assert_eq!(
+                bvh.all_hit(&ray, &tris).hits,
+                brute_force::hit_count(&ray, &tris)
+            );
+        }
+    }
+}

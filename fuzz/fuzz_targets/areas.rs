@@ -206,12 +206,16 @@ fn check_error(err: Option<&AreaError>, reasons: &[Option<&'static str>]) {
     let reasons: Vec<&str> = reasons.iter().flatten().copied().collect();
     if reasons.is_empty() {
         // Beyond the documented bad values, only derived geometry that overflows (coordinates
-        // near `f32::MAX`) or a frustum too thin to have planes may be rejected.
+        // near `f32::MAX`), an area reaching beyond 1e18 or a frustum too thin to have planes
+        // may be rejected.
         if let Some(e) = err {
             assert!(
                 matches!(
                     e,
-                    AreaError::NotFinite(_) | AreaError::FieldOfView(_) | AreaError::NearFar
+                    AreaError::NotFinite(_)
+                        | AreaError::FieldOfView(_)
+                        | AreaError::NearFar
+                        | AreaError::TooLarge(_)
                 ),
                 "{e:?} with no documented reason"
             );

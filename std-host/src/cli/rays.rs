@@ -120,9 +120,15 @@ pub fn parse_rays(reader: impl Read, label: &Path) -> Result<Vec<Ray>, RaysError
                 return Ok(None);
             }
             text.parse::<f32>().map(Some).map_err(|_| {
+                // Echoed escaped and cut short: a quoted cell may hold newlines or a whole file.
+                let shown: String = text.chars().take(40).collect();
+                let more = if text.chars().count() > 40 { "..." } else { "" };
                 error(
                     line,
-                    format!("ray {ray_index}: column '{name}': cannot parse '{text}' as a number"),
+                    format!(
+                        "ray {ray_index}: column '{name}': cannot parse '{}{more}' as a number",
+                        shown.escape_debug()
+                    ),
                 )
             })
         };
@@ -230,6 +236,19 @@ mod tests {
             assert!(e.to_string().contains(why), "{bad}: {e}");
             assert!(e.to_string().contains("rays.csv line 4: "), "{e}");
         }
+    }
+
+    /// A quoted cell can hold newlines (found by the parsers fuzz target): the error echoes it
+    /// escaped and cut short, so it stays one line.
+    #[test]
+    fn unparsable_cell_is_echoed_on_one_line() {
+        let long = "x\n".repeat(100);
+        let e = parse(&format!("ox,oy,oz,dx,dy,dz\n0,0,0,1,\"{long}\",0\n")).unwrap_err();
+        let m = e.to_string();
+        assert!(
+            !m.contains('\n') && m.contains("cannot parse") && m.contains("..."),
+            "{m}"
+        );
     }
 
     #[test]

@@ -19,6 +19,9 @@ pub struct Triangle {
 
 static_assertions::assert_eq_size!(Triangle, [f32; 9]);
 
+/// `(8 eps)^2`: a determinant below `8 eps |d| |e1| |e2|` is rounding noise.
+const DET_EPSILON_SQ: f32 = (8.0 * f32::EPSILON) * (8.0 * f32::EPSILON);
+
 /// A ray/triangle intersection: the ray parameter and the barycentrics of `v1` and `v2`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TriangleHit {
@@ -72,7 +75,9 @@ impl Triangle {
     ///   through a shared edge hits both neighbours and the closest-hit tie rule picks one;
     /// - the segment is closed: hits at exactly `t_min` or `t_max` count;
     /// - degenerate triangles (zero area, so a zero determinant) and rays in the triangle's plane
-    ///   never hit; every comparison rejects NaN, and `t` must be finite, so overflow cannot
+    ///   never hit, also when rounding makes the determinant a few ulps from zero (below
+    ///   `8 eps |d| |e1| |e2|`, rays within about 1e-6 radians of the plane of a well-shaped
+    ///   triangle); every comparison rejects NaN, and `t` must be finite, so overflow cannot
     ///   produce a hit either.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<TriangleHit> {
@@ -95,7 +100,19 @@ impl Triangle {
             return None;
         }
         let t = e2.dot(q) * inv_det;
-        (t >= ray.t_min && t <= t_max && t.is_finite()).then_some(TriangleHit { t, u, v })
+        if !(t >= ray.t_min && t <= t_max && t.is_finite()) {
+            return None;
+        }
+        // A determinant within the rounding error of zero (a degenerate triangle whose edges are
+        // parallel, or a ray in the triangle's plane) gives meaningless u, v and t: the computed
+        // "hit" can lie anywhere, far from the triangle. |det| <= |d| |e1| |e2| always, and its
+        // rounding error is a few ulps of that bound, so such hits are rejected. Checked only
+        // after everything else passed: hits are rare, misses pay nothing.
+        let bound = ray.dir.length_squared() * e1.length_squared() * e2.length_squared();
+        if det * det <= DET_EPSILON_SQ * bound {
+            return None;
+        }
+        Some(TriangleHit { t, u, v })
     }
 }
 
@@ -151,6 +168,38 @@ mod tests {
             assert!(line.intersect(&r, f32::INFINITY).is_none());
             assert!(point.intersect(&r, f32::INFINITY).is_none());
         }
+    }
+
+    #[test]
+    fn rounding_noise_determinants_never_hit() {
+        // Found by the scene fuzz target: a segment-shaped triangle (v1 == v2) whose determinant
+        // rounds to a tiny non-zero value "hit" a ray nowhere near it.
+        let seg = Triangle::new(
+            Vec3::splat(10000.0),
+            Vec3::splat(-7500.0),
+            Vec3::splat(-7500.0),
+        );
+        let r = Ray::new(
+            Vec3::new(-4.946_645_7, -7.766_198, -3.721_115),
+            Vec3::new(-0.460_257_14, -0.836_773_75, -0.296_602_6),
+        )
+        .unwrap();
+        assert!(seg.intersect(&r, f32::INFINITY).is_none());
+        // A ray in a triangle's plane, aimed at its own vertex.
+        let t = Triangle::new(
+            Vec3::ZERO,
+            Vec3::new(1.0, 0.0, 0.3),
+            Vec3::new(0.2, 1.0, 0.7),
+        );
+        let inside = (t.v0 + t.v1 + t.v2) / 3.0;
+        let r = Ray::new(inside, t.v0 - inside).unwrap();
+        assert!(t.intersect(&r, f32::INFINITY).is_none());
+        // A ray about 0.01 radians off the plane, aimed at the centroid, still hits.
+        let n = (t.v1 - t.v0).cross(t.v2 - t.v0).normalize();
+        let origin = inside + (inside - t.v0) - n * 0.01 * (inside - t.v0).length();
+        let r = Ray::new(origin, inside - origin).unwrap();
+        let hit = t.intersect(&r, f32::INFINITY).unwrap();
+        assert!((hit.t - 1.0).abs() < 1e-4);
     }
 
     #[test]

@@ -117,5 +117,5 @@ fi
 section "summary"
 passed=$(grep -Eo '^test result: ok\. [0-9]+ passed' "$LOG_DIR/test.log" | awk '{s += $4} END {print s + 0}')
 ignored=$(grep -Eo '[0-9]+ ignored' "$LOG_DIR/test.log" | awk '{s += $1} END {print s + 0}')
-echo "ignored tests: $ignored (open core bugs are marked CORE BUG in tests/tests/core_regressions.rs)"
+echo "ignored tests: $ignored (open bugs are marked CORE BUG or HOST BUG in tests/tests/)"
 echo "tests: $passed passed, 0 failed"

@@ -255,13 +255,17 @@ impl<L: AreaLookup> Scene<L> {
                 if !area.is_affine(ray) {
                     return None;
                 }
-                // The origin is inside up to the containment tolerance, so even when rounding
-                // puts the clipped entry a hair past `t_min` (rays starting on the light's
-                // rectangle or the near plane), the segment before it stays within that
-                // tolerance of the area, where the conservative SAT selection has every
-                // triangle: the local BVH answers from `t_min`.
-                let (_, t1) = area.polytope().clip_ray(ray)?;
-                Some((a, t1))
+                // The local BVH answers only the part of the segment inside the area. The origin
+                // is inside (up to the containment tolerance), so the segment's start is too
+                // unless it reaches back before the origin (t_min < 0, or -inf): then the area
+                // is skipped and the fallback answers the whole segment. The slack admits rays
+                // that start exactly on the light's rectangle or the near plane, whose clipped
+                // entry rounding puts a hair past t_min: that sliver lies within the tolerance
+                // the conservative triangle selection covers.
+                let (t0, t1) = area.polytope().clip_ray(ray)?;
+                let scale = area.polytope().scale.max(ray.origin.abs().max_element());
+                let slack = 1e-5 * scale / ray.dir.length();
+                (t0 <= ray.t_min + slack).then_some((a, t1))
             })
             .take(self.max_tries as usize)
     }
@@ -451,6 +455,42 @@ mod tests {
             local_answers > 500,
             "local BVHs answered only {local_answers} rays"
         );
+    }
+
+    /// Found by the scene fuzz target: a segment reaching back before its origin (t_min = -inf)
+    /// leaves the area behind the light, where the local BVH has no triangles.
+    #[test]
+    fn segments_reaching_back_out_of_the_area_use_the_fallback() {
+        let area: InfluenceArea = PlaneArea::new(Vec3::ZERO, Vec3::Z, 1.0, 1.0, 2.0)
+            .unwrap()
+            .into();
+        let behind = Triangle::new(
+            Vec3::new(-1.0, -1.0, -0.5),
+            Vec3::new(1.0, -1.0, -0.5),
+            Vec3::new(0.0, 1.0, -0.5),
+        );
+        let tris = [behind];
+        let scene =
+            Scene::with_octree(&tris, alloc::vec![area], &SceneOptions::default(), 5).unwrap();
+        let ray = Ray::segment(
+            Vec3::new(0.1, 0.1, 0.5),
+            Vec3::Z,
+            f32::NEG_INFINITY,
+            f32::INFINITY,
+        )
+        .unwrap();
+        let expect = brute_force::closest_hit(&ray, &tris);
+        assert!(expect.is_some_and(|h| (h.t + 1.0).abs() < 1e-6));
+        assert_eq!(scene.closest_hit(&ray, &tris), expect);
+        assert!(scene.any_hit(&ray, &tris));
+        // From t_min = 0 the same ray is affine, answered locally, and misses.
+        let forward = Ray::new(Vec3::new(0.1, 0.1, 0.5), Vec3::Z).unwrap();
+        let mut stats = SceneStats::default();
+        assert_eq!(
+            scene.closest_hit_with_stats(&forward, &tris, &mut stats),
+            None
+        );
+        assert_eq!(stats.tries, 1);
     }
 
     #[test]

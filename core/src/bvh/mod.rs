@@ -17,10 +17,12 @@ pub use wide::{WideBvh, WideNode};
 use crate::geometry::Aabb;
 use crate::heuristics::{CostConstants, CostModel};
 
-/// The deepest a BVH may be: every builder stops splitting at this depth, and the traversals'
-/// fixed stacks hold this many entries. 64 levels cover any input, since the builder switches to
-/// median splits (which halve the node) before the heuristic could exhaust the budget, and
-/// `log2(u32::MAX) = 32`.
+/// The deepest a BVH may be: no builder splits a node at this depth, and the traversals' fixed
+/// stacks are sized from it (`MAX_DEPTH + 1` entries for the binary tree, `3 MAX_DEPTH + 4` for the
+/// 4-wide one). Once `depth + ceil(log2 n)` reaches the bound, a node is split at its object
+/// median (which halves it), so adversarial inputs can reach depth 64 but never pass it, and since
+/// `log2(u32::MAX) = 32` the halving splits always have room to bring any node down to one
+/// primitive.
 pub const MAX_DEPTH: u32 = 64;
 
 /// A binary BVH over primitives identified by `u32` ids (for triangles, their index in the

@@ -33,6 +33,32 @@ impl Aabb4 {
         }
     }
 
+    /// Four boxes, box `j` in lane `j`.
+    #[inline(always)]
+    pub fn from_boxes(b: [Aabb; 4]) -> Self {
+        Self {
+            min: core::array::from_fn(|k| f32x4::from(b.map(|b| b.min[k]))),
+            max: core::array::from_fn(|k| f32x4::from(b.map(|b| b.max[k]))),
+        }
+    }
+
+    /// The same box in all four lanes: lets a scalar query share a 4-wide code path.
+    #[inline(always)]
+    pub fn splat(b: &Aabb) -> Self {
+        Self {
+            min: [
+                f32x4::splat(b.min.x),
+                f32x4::splat(b.min.y),
+                f32x4::splat(b.min.z),
+            ],
+            max: [
+                f32x4::splat(b.max.x),
+                f32x4::splat(b.max.y),
+                f32x4::splat(b.max.z),
+            ],
+        }
+    }
+
     /// Box `j` (0 to 3) as an [`Aabb`].
     #[inline]
     pub fn lane(&self, j: usize) -> Aabb {

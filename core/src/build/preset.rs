@@ -13,7 +13,9 @@ use crate::heuristics::{
     PahPerspective, PerspectiveMeasure, Sah, SahTermination, Spfh, Termination,
 };
 use crate::influence::InfluenceArea;
+use crate::simd::Aabb4;
 use crate::BuildError;
+use wide::f32x4;
 
 /// A named builder. The thesis's four pairs plus binned SAH over all axes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -225,6 +227,15 @@ impl CostModel for AreaPah {
         match self {
             AreaPah::Ortho(p) => p.measure(b),
             AreaPah::Perspective(p) => p.measure(b),
+        }
+    }
+
+    /// Forwarded so the sweeps get each model's 4-wide evaluation, not four scalar calls.
+    #[inline]
+    fn measure4(&self, b: &Aabb4) -> f32x4 {
+        match self {
+            AreaPah::Ortho(p) => p.measure4(b),
+            AreaPah::Perspective(p) => p.measure4(b),
         }
     }
 }

@@ -9,6 +9,7 @@ mod obb;
 mod polygon;
 mod projection;
 mod ray;
+mod solid_angle;
 mod triangle;
 
 pub(crate) use aabb::pad_far;
@@ -20,4 +21,5 @@ pub use obb::Obb;
 pub use polygon::{ConvexPolygon, MAX_POLY};
 pub use projection::{box_corner, orthographic_silhouette, perspective_silhouette};
 pub use ray::{Ray, RayError};
+pub use solid_angle::box_solid_angle4;
 pub use triangle::{Triangle, TriangleHit};

@@ -4,8 +4,9 @@
 use glam::{Vec2, Vec3};
 use wide::f32x4;
 
-use crate::geometry::{box_corner, perspective_silhouette, Aabb, ConvexPolygon, Frame};
+use crate::geometry::{box_solid_angle4, perspective_silhouette, Aabb, ConvexPolygon, Frame};
 use crate::influence::PointArea;
+use crate::simd::Aabb4;
 
 use super::CostModel;
 
@@ -78,96 +79,10 @@ impl PahPerspective {
         perspective_silhouette(b, self.eye, &self.frame, self.near)
     }
 
-    /// True when `b` lies wholly beyond the near plane and, when culling, wholly inside the
-    /// fields of view: for each bounding plane of the pyramid (normal `n`, through the eye), the
-    /// box's farthest point along `n`, `n . (c - eye) + sum |n_k| h_k`, is on the inner side.
-    #[inline]
-    fn inside_pyramid(&self, b: &Aabb) -> bool {
-        let (c, h) = (b.center() - self.eye, b.extent() * 0.5);
-        let f = &self.frame;
-        let reach = |n: Vec3| n.dot(c) + n.abs().dot(h);
-        if reach(-f.forward) > -self.near {
-            return false;
-        }
-        if !self.cull {
-            return true;
-        }
-        [
-            f.right - f.forward * self.tan_x,
-            -f.right - f.forward * self.tan_x,
-            f.up - f.forward * self.tan_y,
-            -f.up - f.forward * self.tan_y,
-        ]
-        .iter()
-        .all(|&n| reach(n) <= 0.0)
-    }
-
-    /// The measure of a box that lies wholly beyond the near plane and (when culling) inside the
-    /// fields of view, without a hull: seen from a point outside a box, the faces turned towards it
-    /// tile the silhouette, one face per axis at most, so the measure is a sum over those faces.
-    /// Solid angle: an axis-aligned rectangle at distance `d` with corners `(u, v)` relative to
-    /// the eye subtends `sum +- atan(u v / (d sqrt(u^2 + v^2 + d^2)))` over its corners, four
-    /// arctangents in one 4-wide evaluation per face (the four terms cancel for small, far faces,
-    /// which costs up to 1e-3 relative precision in f32: far below what a cost estimate can tell
-    /// apart). Image-plane area: each face's projected quad by the shoelace formula. `None` for
-    /// every other box (the hull path handles it).
-    #[inline]
-    fn front_faces(&self, b: &Aabb) -> Option<f32> {
-        if b.contains_point(self.eye) || !self.inside_pyramid(b) {
-            return None;
-        }
-        let mut total = 0.0;
-        for k in 0..3 {
-            let (near_face, side) = if self.eye[k] < b.min[k] {
-                (b.min[k], 0)
-            } else if self.eye[k] > b.max[k] {
-                (b.max[k], 1 << k)
-            } else {
-                continue;
-            };
-            let (a1, a2) = ((k + 1) % 3, (k + 2) % 3);
-            total += match self.measure {
-                PerspectiveMeasure::SolidAngle => {
-                    let d = (near_face - self.eye[k]).abs();
-                    let (u1, u2) = (b.min[a1] - self.eye[a1], b.max[a1] - self.eye[a1]);
-                    let (v1, v2) = (b.min[a2] - self.eye[a2], b.max[a2] - self.eye[a2]);
-                    let u = f32x4::from([u2, u1, u2, u1]);
-                    let v = f32x4::from([v2, v2, v1, v1]);
-                    let dd = f32x4::splat(d);
-                    let f = (u * v / (dd * (u * u + v * v + dd * dd).sqrt())).atan();
-                    let f = f.to_array();
-                    (f[0] - f[1] - f[2] + f[3]).abs()
-                }
-                PerspectiveMeasure::ImagePlane => {
-                    let quad = [
-                        side,
-                        side | 1 << a1,
-                        side | 1 << a1 | 1 << a2,
-                        side | 1 << a2,
-                    ];
-                    let p = quad.map(|i| {
-                        let q = self.frame.to_local(box_corner(b, i) - self.eye);
-                        Vec2::new(q.x, q.y) / q.z
-                    });
-                    0.5 * (p[0].perp_dot(p[1])
-                        + p[1].perp_dot(p[2])
-                        + p[2].perp_dot(p[3])
-                        + p[3].perp_dot(p[0]))
-                    .abs()
-                }
-            };
-        }
-        Some(total)
-    }
-}
-
-impl CostModel for PahPerspective {
-    fn measure(&self, b: &Aabb) -> f32 {
+    /// The hull path: the silhouette beyond the near plane, clipped to the window when culling.
+    fn hull_measure(&self, b: &Aabb) -> f32 {
         if b.is_empty() {
             return 0.0;
-        }
-        if let Some(m) = self.front_faces(b) {
-            return m;
         }
         let mut poly = self.silhouette(b);
         if self.cull {
@@ -178,6 +93,166 @@ impl CostModel for PahPerspective {
             PerspectiveMeasure::SolidAngle => poly.solid_angle_on_image_plane(),
             PerspectiveMeasure::ImagePlane => poly.area(),
         }
+    }
+
+    /// Which lanes of `b` lie wholly beyond the near plane and, when culling, wholly inside the
+    /// fields of view (such a box never contains the eye, since the near distance is positive).
+    /// For each bounding plane of the pyramid (normal `n`, through the eye) the box's farthest
+    /// point along `n`, `n . (c - eye) + sum |n_k| h_k`, must be on the inner side. Empty and NaN
+    /// lanes fail every comparison, so they are never inside.
+    #[inline(always)]
+    fn inside_pyramid4(&self, rel_lo: &[f32x4; 3], rel_hi: &[f32x4; 3]) -> f32x4 {
+        let half = f32x4::splat(0.5);
+        let c: [f32x4; 3] = core::array::from_fn(|k| (rel_lo[k] + rel_hi[k]) * half);
+        let h: [f32x4; 3] = core::array::from_fn(|k| (rel_hi[k] - rel_lo[k]) * half);
+        let reach = |n: Vec3| {
+            let a = n.abs();
+            c[0] * f32x4::splat(n.x)
+                + c[1] * f32x4::splat(n.y)
+                + c[2] * f32x4::splat(n.z)
+                + h[0] * f32x4::splat(a.x)
+                + h[1] * f32x4::splat(a.y)
+                + h[2] * f32x4::splat(a.z)
+        };
+        let f = &self.frame;
+        let mut inside = reach(-f.forward).simd_le(f32x4::splat(-self.near));
+        if self.cull {
+            let zero = f32x4::ZERO;
+            for n in [
+                f.right - f.forward * self.tan_x,
+                -f.right - f.forward * self.tan_x,
+                f.up - f.forward * self.tan_y,
+                -f.up - f.forward * self.tan_y,
+            ] {
+                inside &= reach(n).simd_le(zero);
+            }
+        }
+        inside
+    }
+
+    /// The measures of four boxes without a hull, and the mask of the lanes where they are exact:
+    /// the boxes wholly beyond the near plane and (when culling) inside the fields of view, which
+    /// are most boxes of a build below its top levels. Seen from a point outside a box, the faces
+    /// turned towards it tile the silhouette, one face per axis at most, so the measure is a sum
+    /// over those faces.
+    ///
+    /// Solid angle: [`box_solid_angle4`], one `atan2` per box, exact also for small, far boxes.
+    ///
+    /// Image-plane area: each face's projected quad by the shoelace formula.
+    #[inline(always)]
+    fn front_faces4(&self, b: &Aabb4) -> (f32x4, f32x4) {
+        let e = self.eye;
+        let rel_lo = [
+            b.min[0] - f32x4::splat(e.x),
+            b.min[1] - f32x4::splat(e.y),
+            b.min[2] - f32x4::splat(e.z),
+        ];
+        let rel_hi = [
+            b.max[0] - f32x4::splat(e.x),
+            b.max[1] - f32x4::splat(e.y),
+            b.max[2] - f32x4::splat(e.z),
+        ];
+        let inside = self.inside_pyramid4(&rel_lo, &rel_hi);
+        if inside.to_bitmask() == 0 {
+            return (f32x4::ZERO, inside);
+        }
+        if self.measure == PerspectiveMeasure::SolidAngle {
+            return (box_solid_angle4(&rel_lo, &rel_hi), inside);
+        }
+        let zero = f32x4::ZERO;
+        let mut total = zero;
+        for k in 0..3 {
+            let (a1, a2) = ((k + 1) % 3, (k + 2) % 3);
+            // The eye below the slab sees the face at the minimum, above it the one at the maximum.
+            let below = rel_lo[k].simd_gt(zero);
+            let visible = below | rel_hi[k].simd_lt(zero);
+            if (visible & inside).to_bitmask() == 0 {
+                continue;
+            }
+            let face = self.face_image_area4(
+                k,
+                below,
+                [rel_lo[k], rel_lo[a1], rel_lo[a2]],
+                [rel_hi[k], rel_hi[a1], rel_hi[a2]],
+                [a1, a2],
+            );
+            total += visible.select(face, zero);
+        }
+        (total, inside)
+    }
+
+    /// The image-plane area of each lane's face on axis `k` (at the minimum where `below`, else
+    /// the maximum): its four corners in frame coordinates, divided by depth, by the shoelace
+    /// formula. `lo` and `hi` hold the eye-relative bounds on axes `k`, `a[0]`, `a[1]`.
+    #[inline(always)]
+    fn face_image_area4(
+        &self,
+        k: usize,
+        below: f32x4,
+        lo: [f32x4; 3],
+        hi: [f32x4; 3],
+        a: [usize; 2],
+    ) -> f32x4 {
+        let f = &self.frame;
+        // Column `axis` of the world-to-frame matrix, times a coordinate on that axis.
+        let column = |axis: usize, t: f32x4| {
+            [
+                t * f32x4::splat(f.right[axis]),
+                t * f32x4::splat(f.up[axis]),
+                t * f32x4::splat(f.forward[axis]),
+            ]
+        };
+        let plane = column(k, below.select(lo[0], hi[0]));
+        let (u1, u2) = (column(a[0], lo[1]), column(a[0], hi[1]));
+        let (v1, v2) = (column(a[1], lo[2]), column(a[1], hi[2]));
+        let project = |u: &[f32x4; 3], v: &[f32x4; 3]| {
+            let inv_z = f32x4::ONE / (plane[2] + u[2] + v[2]);
+            (
+                (plane[0] + u[0] + v[0]) * inv_z,
+                (plane[1] + u[1] + v[1]) * inv_z,
+            )
+        };
+        let p = [
+            project(&u1, &v1),
+            project(&u2, &v1),
+            project(&u2, &v2),
+            project(&u1, &v2),
+        ];
+        let cross = |i: usize, j: usize| p[i].0 * p[j].1 - p[i].1 * p[j].0;
+        (cross(0, 1) + cross(1, 2) + cross(2, 3) + cross(3, 0)).abs() * f32x4::splat(0.5)
+    }
+}
+
+impl CostModel for PahPerspective {
+    fn measure(&self, b: &Aabb) -> f32 {
+        if b.is_empty() {
+            return 0.0;
+        }
+        let (m, inside) = self.front_faces4(&Aabb4::splat(b));
+        if inside.to_bitmask() & 1 != 0 {
+            m.to_array()[0]
+        } else {
+            self.hull_measure(b)
+        }
+    }
+
+    /// Four boxes at once: the hull-free path for every lane inside the pyramid, the hull for
+    /// the rest (boxes at the top of a build, straddling the window or the near plane, and empty
+    /// padding lanes).
+    #[inline]
+    fn measure4(&self, b: &Aabb4) -> f32x4 {
+        let (m, inside) = self.front_faces4(b);
+        let mask = inside.to_bitmask();
+        if mask == 0b1111 {
+            return m;
+        }
+        let mut out = m.to_array();
+        for (j, o) in out.iter_mut().enumerate() {
+            if mask & (1 << j) == 0 {
+                *o = self.hull_measure(&b.lane(j));
+            }
+        }
+        f32x4::from(out)
     }
 }
 
@@ -241,24 +316,14 @@ mod tests {
                             rng.range(0.0, 3.0),
                         ),
                     );
-                    let Some(fast) = pah.front_faces(&b) else {
+                    let (fast, inside) = pah.front_faces4(&Aabb4::splat(&b));
+                    if inside.to_bitmask() != 0b1111 {
                         continue;
-                    };
-                    let mut poly = pah.silhouette(&b);
-                    if cull {
-                        poly = poly.clip_to_rect(
-                            -Vec2::new(pah.tan_x, pah.tan_y),
-                            Vec2::new(pah.tan_x, pah.tan_y),
-                        );
                     }
-                    let hull = match m {
-                        PerspectiveMeasure::SolidAngle => poly.solid_angle_on_image_plane(),
-                        PerspectiveMeasure::ImagePlane => poly.area(),
-                    };
-                    // The corner formula cancels for small, far faces: 1e-3 relative in f32, far
-                    // below what a cost estimate can tell apart.
+                    let fast = fast.to_array()[0];
+                    let hull = pah.hull_measure(&b);
                     assert!(
-                        (fast - hull).abs() <= 1e-3 * hull.max(1e-3),
+                        (fast - hull).abs() <= 1e-4 * hull.max(1e-3),
                         "{m:?} {b:?}: {fast} vs {hull}"
                     );
                     checked += 1;
@@ -266,6 +331,63 @@ mod tests {
             }
         }
         assert!(checked > 2000, "the fast path ran {checked} times");
+    }
+
+    #[test]
+    fn four_lanes_equal_one_at_a_time() {
+        let area =
+            PointArea::new(Vec3::new(0.5, 0.2, -3.0), Vec3::Z, 90.0, 70.0, 0.5, 50.0).unwrap();
+        let mut rng = crate::random::Pcg32::new(11);
+        for m in [
+            PerspectiveMeasure::SolidAngle,
+            PerspectiveMeasure::ImagePlane,
+        ] {
+            let pah = PahPerspective::for_area(&area, m);
+            for _ in 0..500 {
+                // Boxes inside the window, straddling it or the near plane, behind the eye, and
+                // empty, mixed in one group of four.
+                let lanes: [Aabb; 4] = core::array::from_fn(|_| {
+                    if rng.range(0.0, 1.0) < 0.1 {
+                        return Aabb::EMPTY;
+                    }
+                    let lo = Vec3::new(
+                        rng.range(-8.0, 8.0),
+                        rng.range(-8.0, 8.0),
+                        rng.range(-6.0, 20.0),
+                    );
+                    Aabb::new(
+                        lo,
+                        lo + Vec3::new(
+                            rng.range(0.0, 4.0),
+                            rng.range(0.0, 4.0),
+                            rng.range(0.0, 4.0),
+                        ),
+                    )
+                });
+                let four = pah.measure4(&Aabb4::from_boxes(lanes)).to_array();
+                for (j, b) in lanes.iter().enumerate() {
+                    assert_eq!(four[j].to_bits(), pah.measure(b).to_bits(), "{m:?} {b:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn solid_angle_is_scale_free_and_exact_for_far_small_faces() {
+        // A unit cube 1e4 away straight ahead shows one face: about 1 / r^2 steradians.
+        let base = Aabb::new(Vec3::new(-0.5, -0.5, 1e4), Vec3::new(0.5, 0.5, 1e4 + 1.0));
+        for scale in [1e-12f32, 1e-6, 1.0, 1e6, 1e12] {
+            let area =
+                PointArea::new(Vec3::ZERO, Vec3::Z, 60.0, 60.0, 0.5 * scale, 2e4 * scale).unwrap();
+            let pah = PahPerspective::for_area(&area, PerspectiveMeasure::SolidAngle);
+            let b = Aabb::new(base.min * scale, base.max * scale);
+            let got = pah.measure(&b);
+            let expect = 4.0 * libm::atanf(0.25 / (1e4 * libm::sqrtf(1e8 + 0.5)));
+            assert!(
+                (got - expect).abs() <= 1e-5 * expect,
+                "scale {scale}: {got} vs {expect}"
+            );
+        }
     }
 
     /// The measure over the window measure is the probability that a sampled ray hits the box.

@@ -80,6 +80,15 @@ impl Aabb4 {
         )
     }
 
+    /// The lanes that hold an empty box (a lower bound above the upper one on some axis), as
+    /// a mask: sweeps pad their last group of four with empty boxes.
+    #[inline(always)]
+    pub fn empty(&self) -> f32x4 {
+        self.min[0].simd_gt(self.max[0])
+            | self.min[1].simd_gt(self.max[1])
+            | self.min[2].simd_gt(self.max[2])
+    }
+
     /// Extents per axis, clamped at zero (empty lanes have none).
     #[inline(always)]
     pub fn extent(&self) -> [f32x4; 3] {

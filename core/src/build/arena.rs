@@ -180,9 +180,15 @@ impl SweepSide {
         )
     }
 
-    /// The measures and counts of boundaries `i..i + 4`.
+    /// The measures and counts of boundaries `i..i + 4`, all inside a node whose
+    /// [`CostModel::hint`](crate::heuristics::CostModel::hint) is `hint`.
     #[inline(always)]
-    pub fn lanes<M: crate::heuristics::CostModel>(&self, i: usize, model: &M) -> (f32x4, f32x4) {
+    pub fn lanes<M: crate::heuristics::CostModel>(
+        &self,
+        i: usize,
+        model: &M,
+        hint: u32,
+    ) -> (f32x4, f32x4) {
         let [min_x, min_y, min_z, _] = f32x4::transpose([
             self.min[i],
             self.min[i + 1],
@@ -206,7 +212,7 @@ impl SweepSide {
             c[i + 2] as f32,
             c[i + 3] as f32,
         ]);
-        (model.measure4(&b4), n)
+        (model.measure4_hinted(&b4, hint), n)
     }
 }
 

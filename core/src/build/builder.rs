@@ -439,9 +439,12 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         let maps = self.bin(arena, task, bounds, binned, nb);
         let nb = nb as usize;
         let BuildArena { bins, sweep, .. } = arena;
+        // Every candidate box lies inside the node: what the model can settle for all of them
+        // (say, that they are inside the light's window) it settles once here.
+        let hint = model.hint(bounds);
         let mut sweep_axis = |axis: usize, model: &M| {
             let t0 = clock.now_ns();
-            let split = sweep_axis(&bins[axis][..nb], sweep, axis, maps[axis]?, model);
+            let split = sweep_axis(&bins[axis][..nb], sweep, axis, maps[axis]?, model, hint);
             profile.cost_ns += clock.now_ns() - t0;
             profile.cost_calls += 1;
             split
@@ -482,7 +485,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                         let t0 = clock.now_ns();
                         // Found under SAH, priced under `model` like every other candidate.
                         let fallback = maps[axis].and_then(|m| {
-                            self::sweep_axis(&bins[axis][..nb], sweep, axis, m, &Sah)
+                            self::sweep_axis(&bins[axis][..nb], sweep, axis, m, &Sah, 0)
                                 .map(|s| s.priced_under(model))
                         });
                         profile.cost_ns += clock.now_ns() - t0;
@@ -564,6 +567,7 @@ fn sweep_axis<M: CostModel>(
     axis: usize,
     map: BinMap,
     model: &M,
+    hint: u32,
 ) -> Option<Split> {
     let nb = bins.len();
     // Boundary i (1..nb) separates bins[..i] from bins[i..]; lanes past nb - 1 get empty sides.
@@ -591,8 +595,8 @@ fn sweep_axis<M: CostModel>(
     let (mut best_ml, mut best_mr) = (zero, zero);
     let mut index = f32x4::from([1.0, 2.0, 3.0, 4.0]);
     for i in (1..nb).step_by(4) {
-        let (ml, nl) = sweep.left.lanes(i, model);
-        let (mr, nr) = sweep.right.lanes(i, model);
+        let (ml, nl) = sweep.left.lanes(i, model, hint);
+        let (mr, nr) = sweep.right.lanes(i, model, hint);
         let valid = nl.simd_gt(zero) & nr.simd_gt(zero);
         let w = valid.select(ml * nl + mr * nr, inf);
         let better = w.simd_lt(best_w);

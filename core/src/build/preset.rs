@@ -193,6 +193,9 @@ impl From<BuildError> for PresetError {
 
 /// PAH for an influence area: orthographic for a plane area, perspective for a point area. For
 /// estimating a built tree's cost (the builders themselves are monomorphised per kind).
+// The perspective model carries its 4-wide constants (about 600 bytes): one value per build or
+// estimate lives on the stack, and boxing it would allocate where builds promise not to.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum AreaPah {
     /// Parallel rays.
@@ -236,6 +239,22 @@ impl CostModel for AreaPah {
         match self {
             AreaPah::Ortho(p) => p.measure4(b),
             AreaPah::Perspective(p) => p.measure4(b),
+        }
+    }
+
+    #[inline]
+    fn hint(&self, node: &Aabb) -> u32 {
+        match self {
+            AreaPah::Ortho(p) => p.hint(node),
+            AreaPah::Perspective(p) => p.hint(node),
+        }
+    }
+
+    #[inline]
+    fn measure4_hinted(&self, b: &Aabb4, hint: u32) -> f32x4 {
+        match self {
+            AreaPah::Ortho(p) => p.measure4_hinted(b, hint),
+            AreaPah::Perspective(p) => p.measure4_hinted(b, hint),
         }
     }
 }

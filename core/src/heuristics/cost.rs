@@ -53,6 +53,25 @@ pub trait CostModel {
             self.measure(&b.lane(3)),
         ])
     }
+
+    /// What the model can settle once for every box inside `node`, before a sweep prices its
+    /// candidates (all of which lie inside the node): say, that they all lie inside the light's
+    /// window, so no lane needs the culling test. Opaque to the builder, which hands it back to
+    /// [`CostModel::measure4_hinted`]. The default settles nothing (0).
+    #[inline]
+    fn hint(&self, node: &Aabb) -> u32 {
+        let _ = node;
+        0
+    }
+
+    /// [`CostModel::measure4`] for four boxes that lie inside a node whose [`CostModel::hint`]
+    /// was `hint` (or that are empty). It must return what `measure4` returns for them; it may
+    /// only skip work. The default is `measure4`.
+    #[inline]
+    fn measure4_hinted(&self, b: &Aabb4, hint: u32) -> f32x4 {
+        let _ = hint;
+        self.measure4(b)
+    }
 }
 
 /// The surface area heuristic (MacDonald and Booth 1990): uniformly distributed rays hit a convex
@@ -81,5 +100,15 @@ impl<C: CostModel + ?Sized> CostModel for &C {
     #[inline]
     fn measure4(&self, b: &Aabb4) -> f32x4 {
         (**self).measure4(b)
+    }
+
+    #[inline]
+    fn hint(&self, node: &Aabb) -> u32 {
+        (**self).hint(node)
+    }
+
+    #[inline]
+    fn measure4_hinted(&self, b: &Aabb4, hint: u32) -> f32x4 {
+        (**self).measure4_hinted(b, hint)
     }
 }

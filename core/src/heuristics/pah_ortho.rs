@@ -96,6 +96,25 @@ impl PahOrtho {
         w.x * e.y * e.z + w.y * e.x * e.z + w.z * e.x * e.y
     }
 
+    /// The closed-form projected areas of four boxes, ignoring the window (zero for empty lanes:
+    /// their extents clamp at zero).
+    #[inline(always)]
+    fn projected_area4(&self, b: &Aabb4) -> f32x4 {
+        let [ex, ey, ez] = b.extent();
+        let w = self.weights;
+        f32x4::splat(w.x) * ey * ez + f32x4::splat(w.y) * ex * ez + f32x4::splat(w.z) * ex * ey
+    }
+
+    /// True when the projection of `b` lies inside the window `w`: along each window axis the
+    /// projection spans the centre's coordinate +- the sum of `|axis_k| e_k / 2`.
+    #[inline]
+    fn projects_inside(w: &Window, b: &Aabb) -> bool {
+        let (c, h) = (b.center(), b.extent() * 0.5);
+        let (cx, hx) = (c.dot(w.right), h.dot(w.right.abs()));
+        let (cy, hy) = (c.dot(w.up), h.dot(w.up.abs()));
+        cx - hx >= w.lo.x && cx + hx <= w.hi.x && cy - hy >= w.lo.y && cy + hy <= w.hi.y
+    }
+
     /// The exact projected area of `b` inside the window `w`: hull of the eight projected
     /// corners, clipped to the rectangle.
     fn clipped_area(w: &Window, b: &Aabb) -> f32 {
@@ -119,7 +138,7 @@ impl CostModel for PahOrtho {
         let (c, h) = (b.center(), b.extent() * 0.5);
         let (cx, hx) = (c.dot(w.right), h.dot(w.right.abs()));
         let (cy, hy) = (c.dot(w.up), h.dot(w.up.abs()));
-        if cx - hx >= w.lo.x && cx + hx <= w.hi.x && cy - hy >= w.lo.y && cy + hy <= w.hi.y {
+        if Self::projects_inside(w, b) {
             full
         } else if cx + hx <= w.lo.x || cx - hx >= w.hi.x || cy + hy <= w.lo.y || cy - hy >= w.hi.y {
             0.0
@@ -129,16 +148,15 @@ impl CostModel for PahOrtho {
     }
 
     /// Four boxes in one closed-form evaluation; with a window, the lanes whose projection is not
-    /// entirely inside it are measured one by one.
-    #[inline]
+    /// entirely inside it are measured one by one. Always inlined: the sweep calls it per group
+    /// of four boundaries, and a call would pass the 96-byte box group through memory.
+    #[inline(always)]
     fn measure4(&self, b: &Aabb4) -> f32x4 {
-        let [ex, ey, ez] = b.extent();
-        let w = self.weights;
-        let full =
-            f32x4::splat(w.x) * ey * ez + f32x4::splat(w.y) * ex * ez + f32x4::splat(w.z) * ex * ey;
+        let full = self.projected_area4(b);
         let Some(win) = &self.window else {
             return full;
         };
+        let [ex, ey, ez] = b.extent();
         let half = f32x4::splat(0.5);
         let c = [
             (b.min[0] + b.max[0]) * half,
@@ -151,21 +169,51 @@ impl CostModel for PahOrtho {
         };
         let (cx, hx) = (dot(&c, win.right), dot(&h, win.right.abs()));
         let (cy, hy) = (dot(&c, win.up), dot(&h, win.up.abs()));
-        let inside = (cx - hx).simd_ge(f32x4::splat(win.lo.x))
-            & (cx + hx).simd_le(f32x4::splat(win.hi.x))
-            & (cy - hy).simd_ge(f32x4::splat(win.lo.y))
-            & (cy + hy).simd_le(f32x4::splat(win.hi.y));
+        let (lo_x, lo_y) = (f32x4::splat(win.lo.x), f32x4::splat(win.lo.y));
+        let (hi_x, hi_y) = (f32x4::splat(win.hi.x), f32x4::splat(win.hi.y));
+        let inside = (cx - hx).simd_ge(lo_x)
+            & (cx + hx).simd_le(hi_x)
+            & (cy - hy).simd_ge(lo_y)
+            & (cy + hy).simd_le(hi_y);
         if inside.all() {
             return full;
         }
-        let mut out = full.to_array();
-        let inside = inside.to_bitmask();
+        // Empty lanes (sweep padding) and projections wholly outside the window measure zero
+        // here too; only lanes straddling the window's border take the hull clip.
+        let outside = (cx + hx).simd_le(lo_x)
+            | (cx - hx).simd_ge(hi_x)
+            | (cy + hy).simd_le(lo_y)
+            | (cy - hy).simd_ge(hi_y)
+            | b.empty();
+        let zeroed = outside.select(f32x4::ZERO, full);
+        let straddling = !(inside | outside).to_bitmask() & 0b1111;
+        if straddling == 0 {
+            return zeroed;
+        }
+        let mut out = zeroed.to_array();
         for (j, m) in out.iter_mut().enumerate() {
-            if inside & (1 << j) == 0 {
+            if straddling & (1 << j) != 0 {
                 *m = self.measure(&b.lane(j));
             }
         }
         f32x4::from(out)
+    }
+
+    /// 1 when the node's projection lies inside the window: then so does every box inside it.
+    fn hint(&self, node: &Aabb) -> u32 {
+        match &self.window {
+            Some(w) if !node.is_empty() => u32::from(Self::projects_inside(w, node)),
+            _ => 0,
+        }
+    }
+
+    /// With the whole node inside the window, the closed form alone (zero for empty lanes).
+    #[inline(always)]
+    fn measure4_hinted(&self, b: &Aabb4, hint: u32) -> f32x4 {
+        if hint == 0 {
+            return self.measure4(b);
+        }
+        self.projected_area4(b)
     }
 }
 

@@ -2,6 +2,7 @@
 //! depth recorded at build time so that traversal stacks are provably large enough.
 
 mod node;
+mod traversable;
 mod traverse;
 mod validate;
 mod wide;
@@ -10,6 +11,7 @@ mod wide_traverse;
 use alloc::vec::Vec;
 
 pub use node::BvhNode;
+pub use traversable::Traversable;
 pub use traverse::{AllHitStats, Hit, TraversalStats};
 pub use validate::InvariantError;
 pub use wide::{WideBvh, WideNode};

@@ -178,7 +178,7 @@ mod tests {
     fn matches_the_f64_triangle_sum_over_scales_and_positions() {
         let mut rng = Pcg32::new(5);
         for scale in [1e-20f32, 1e-3, 1.0, 1e3, 1e20] {
-            for _ in 0..400 {
+            for _ in 0..if cfg!(miri) { 4 } else { 400 } {
                 // Boxes in front of the eye (z > 0), some small and far, some wide and close.
                 let lanes: [([f32; 3], [f32; 3]); 4] = core::array::from_fn(|_| {
                     let size = if rng.range(0.0, 1.0) < 0.5 { 1e-3 } else { 5.0 };
@@ -210,7 +210,7 @@ mod tests {
     fn far_field_stays_within_its_bound() {
         let mut rng = Pcg32::new(9);
         let mut worst = 0.0f64;
-        for _ in 0..4000 {
+        for _ in 0..if cfg!(miri) { 40 } else { 4000 } {
             // A box whose half-diagonal is at most 1% of its centre's distance, in any direction
             // in front of the eye, with any aspect ratio.
             let dir = [
@@ -239,8 +239,9 @@ mod tests {
             worst = worst.max((got - expect).abs() / expect);
         }
         assert!(worst <= 2.1e-4, "worst relative error {worst}");
-        // The bound is not vacuous: boxes near the threshold do show the midpoint rule's error.
-        assert!(worst > 1e-5, "worst relative error {worst}");
+        // The bound is not vacuous: boxes near the threshold do show the midpoint rule's error
+        // (Miri runs too few boxes to be sure to meet one).
+        assert!(cfg!(miri) || worst > 1e-5, "worst relative error {worst}");
     }
 
     #[test]

@@ -5,7 +5,7 @@ use core::fmt;
 
 use super::{AreaList, AreaLookup, BreakEven, Octree};
 use crate::build::{BuildArena, Preset, PresetError, PresetOptions};
-use crate::bvh::{Bvh, Hit, TraversalStats};
+use crate::bvh::{Bvh, Hit, Traversable, TraversalStats, WideBvh};
 use crate::geometry::{Ray, Triangle};
 use crate::heuristics::CostConstants;
 use crate::influence::InfluenceArea;
@@ -98,11 +98,14 @@ impl SceneStats {
 /// segment up to `t_exit` lies inside the area, and every triangle meeting the area is in its
 /// local BVH by the exact separating-axis test). Otherwise the fallback BVH answers the rest of the
 /// segment. Every answer equals the brute-force one.
+///
+/// The trees `T` are binary [`Bvh`]s as built; [`Scene::widen`] turns every one into a
+/// [`WideBvh`] (4-wide nodes, the faster traversal) with the same answers.
 #[derive(Clone, Debug)]
-pub struct Scene<L: AreaLookup = Octree> {
+pub struct Scene<L: AreaLookup = Octree, T: Traversable = Bvh> {
     areas: Vec<InfluenceArea>,
-    local: Vec<Bvh>,
-    fallback: Bvh,
+    local: Vec<T>,
+    fallback: T,
     lookup: L,
     max_tries: u32,
 }
@@ -173,14 +176,28 @@ impl<L: AreaLookup> Scene<L> {
         })
     }
 
+    /// The same scene with every local and the fallback BVH collapsed to 4-wide nodes
+    /// ([`WideBvh::from_binary`]): same areas, lookup and answers, faster queries.
+    pub fn widen(self) -> Scene<L, WideBvh> {
+        Scene {
+            areas: self.areas,
+            local: self.local.iter().map(WideBvh::from_binary).collect(),
+            fallback: WideBvh::from_binary(&self.fallback),
+            lookup: self.lookup,
+            max_tries: self.max_tries,
+        }
+    }
+}
+
+impl<L: AreaLookup, T: Traversable> Scene<L, T> {
     /// Assembles a scene from parts built elsewhere (a threaded host builds the local BVHs in
     /// parallel). `None` unless there is one local BVH per area. The caller vouches that each
     /// local BVH holds every triangle overlapping its area (as [`Scene::build`] selects them):
     /// the exactness of the queries rests on it.
     pub fn from_parts(
         areas: Vec<InfluenceArea>,
-        local: Vec<Bvh>,
-        fallback: Bvh,
+        local: Vec<T>,
+        fallback: T,
         lookup: L,
         max_tries: u32,
     ) -> Option<Self> {
@@ -213,20 +230,17 @@ impl<L: AreaLookup> Scene<L> {
     }
 
     /// The local BVH of each area.
-    pub fn local_bvhs(&self) -> &[Bvh] {
+    pub fn local_bvhs(&self) -> &[T] {
         &self.local
     }
 
     /// How many triangles each area's local BVH holds.
     pub fn triangles_per_area(&self) -> Vec<u32> {
-        self.local
-            .iter()
-            .map(|b| b.prim_indices().len() as u32)
-            .collect()
+        self.local.iter().map(|b| b.prim_count() as u32).collect()
     }
 
     /// The fallback BVH.
-    pub fn fallback(&self) -> &Bvh {
+    pub fn fallback(&self) -> &T {
         &self.fallback
     }
 
@@ -237,7 +251,7 @@ impl<L: AreaLookup> Scene<L> {
 
     /// Bytes of every BVH, the lookup and the areas.
     pub fn memory_bytes(&self) -> usize {
-        self.local.iter().map(Bvh::memory_bytes).sum::<usize>()
+        self.local.iter().map(T::memory_bytes).sum::<usize>()
             + self.fallback.memory_bytes()
             + self.lookup.memory_bytes()
             + self.areas.len() * core::mem::size_of::<InfluenceArea>()
@@ -422,8 +436,10 @@ mod tests {
         let options = SceneOptions::default();
         let octree = Scene::with_octree(&tris, areas(), &options, 5).unwrap();
         let list = Scene::with_list(&tris, areas(), &options).unwrap();
+        let wide = octree.clone().widen();
+        assert_eq!(wide.triangles_per_area(), octree.triangles_per_area());
         let mut rng = Pcg32::new(4);
-        let mut local_answers = 0;
+        let (mut local_answers, mut wide_local_answers) = (0, 0);
         for (i, area) in areas().into_iter().enumerate() {
             let mut sampler = RaySampler::new(area, i as u64);
             for j in 0..2000 {
@@ -446,6 +462,10 @@ mod tests {
                 let mut s = SceneStats::default();
                 assert_eq!(octree.closest_hit_with_stats(&ray, &tris, &mut s), expect);
                 local_answers += usize::from(s.answered_by.is_some());
+                let mut w = SceneStats::default();
+                assert_eq!(wide.closest_hit_with_stats(&ray, &tris, &mut w), expect);
+                wide_local_answers += usize::from(w.answered_by.is_some());
+                assert_eq!(wide.any_hit(&ray, &tris), expect.is_some());
                 assert_eq!(list.closest_hit(&ray, &tris), expect);
                 assert_eq!(octree.any_hit(&ray, &tris), expect.is_some());
                 assert_eq!(list.any_hit(&ray, &tris), expect.is_some());
@@ -455,6 +475,8 @@ mod tests {
             local_answers > 500,
             "local BVHs answered only {local_answers} rays"
         );
+        // The same areas answer, whichever trees they hold.
+        assert_eq!(wide_local_answers, local_answers);
     }
 
     /// Found by the scene fuzz target: a segment reaching back before its origin (t_min = -inf)

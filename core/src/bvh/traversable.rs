@@ -1,0 +1,78 @@
+//! What a composite structure needs of a hierarchy: one trait over the binary and the 4-wide
+//! BVH, so a [`crate::toplevel::Scene`]'s local and fallback trees can be either, statically
+//! dispatched.
+
+use super::{Bvh, Hit, TraversalStats, WideBvh};
+use crate::geometry::{Ray, Triangle};
+
+/// Closest-hit and any-hit queries over the triangles a hierarchy was built from, with the work
+/// counted, and its size. Implemented by [`Bvh`] and [`WideBvh`]; both answer exactly as brute
+/// force does, so a scene answers the same with either.
+pub trait Traversable {
+    /// The closest hit on `[ray.t_min, ray.t_max]`, adding the work to `stats`.
+    fn closest_hit_with_stats(
+        &self,
+        ray: &Ray,
+        tris: &[Triangle],
+        stats: &mut TraversalStats,
+    ) -> Option<Hit>;
+
+    /// True when anything is hit on the segment, adding the work to `stats`.
+    fn any_hit_with_stats(&self, ray: &Ray, tris: &[Triangle], stats: &mut TraversalStats) -> bool;
+
+    /// How many primitives the hierarchy holds.
+    fn prim_count(&self) -> usize;
+
+    /// Bytes of its arrays.
+    fn memory_bytes(&self) -> usize;
+}
+
+impl Traversable for Bvh {
+    #[inline]
+    fn closest_hit_with_stats(
+        &self,
+        ray: &Ray,
+        tris: &[Triangle],
+        stats: &mut TraversalStats,
+    ) -> Option<Hit> {
+        Bvh::closest_hit_with_stats(self, ray, tris, stats)
+    }
+
+    #[inline]
+    fn any_hit_with_stats(&self, ray: &Ray, tris: &[Triangle], stats: &mut TraversalStats) -> bool {
+        Bvh::any_hit_with_stats(self, ray, tris, stats)
+    }
+
+    fn prim_count(&self) -> usize {
+        self.prim_indices().len()
+    }
+
+    fn memory_bytes(&self) -> usize {
+        Bvh::memory_bytes(self)
+    }
+}
+
+impl Traversable for WideBvh {
+    #[inline]
+    fn closest_hit_with_stats(
+        &self,
+        ray: &Ray,
+        tris: &[Triangle],
+        stats: &mut TraversalStats,
+    ) -> Option<Hit> {
+        WideBvh::closest_hit_with_stats(self, ray, tris, stats)
+    }
+
+    #[inline]
+    fn any_hit_with_stats(&self, ray: &Ray, tris: &[Triangle], stats: &mut TraversalStats) -> bool {
+        WideBvh::any_hit_with_stats(self, ray, tris, stats)
+    }
+
+    fn prim_count(&self) -> usize {
+        self.prim_indices().len()
+    }
+
+    fn memory_bytes(&self) -> usize {
+        WideBvh::memory_bytes(self)
+    }
+}

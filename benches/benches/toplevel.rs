@@ -13,6 +13,8 @@
 //! over its box, as in `presets.rs`) and the thesis's WoodScene (its oblique plane and point areas
 //! from `../shared/thesis/experiments.toml`). Before timing, the two answers are compared ray by
 //! ray and the mean traversal cost per ray (inner nodes + triangle tests) of each is printed.
+//! `query/SCENE/AREA/{structure,fallback}-wide`: the same after `Scene::widen` (4-wide local and
+//! fallback BVHs), checked ray by ray against the binary scene first.
 //!
 //! Clock per `RDBVH_BENCH_CLOCK` (thread CPU time by default).
 
@@ -165,6 +167,7 @@ fn query(c: &mut Criterion<Clock>) {
                 continue;
             }
         };
+        let wide = scene.clone().widen();
         let short_name = name.rsplit('/').next().unwrap_or(name);
         for (kind, area) in [("plane", plane), ("point", point)] {
             let mut sampler = RaySampler::new(area, RAY_SEED);
@@ -182,6 +185,26 @@ fn query(c: &mut Criterion<Clock>) {
             });
             let fallback = scene.fallback();
             group.bench_function("fallback", |bench| {
+                bench.iter(|| {
+                    black_box(&rays)
+                        .iter()
+                        .filter(|r| fallback.closest_hit(r, &tris).is_some())
+                        .count()
+                })
+            });
+            for r in &rays {
+                assert_eq!(wide.closest_hit(r, &tris), scene.closest_hit(r, &tris));
+            }
+            group.bench_function("structure-wide", |bench| {
+                bench.iter(|| {
+                    black_box(&rays)
+                        .iter()
+                        .filter(|r| wide.closest_hit(r, &tris).is_some())
+                        .count()
+                })
+            });
+            let fallback = wide.fallback();
+            group.bench_function("fallback-wide", |bench| {
                 bench.iter(|| {
                     black_box(&rays)
                         .iter()

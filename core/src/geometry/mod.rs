@@ -10,6 +10,7 @@ mod polygon;
 mod projection;
 mod ray;
 mod triangle;
+mod triangle4;
 
 pub(crate) use aabb::pad_far;
 pub use aabb::Aabb;
@@ -21,3 +22,4 @@ pub use polygon::{ConvexPolygon, MAX_POLY};
 pub use projection::{box_corner, orthographic_silhouette, perspective_silhouette};
 pub use ray::{Ray, RayError};
 pub use triangle::{Triangle, TriangleHit};
+pub use triangle4::{Hits4, RayTri4, Triangle4};

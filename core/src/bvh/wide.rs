@@ -27,6 +27,8 @@ pub struct WideNode {
 
 static_assertions::assert_eq_size!(WideNode, [u8; 128]);
 static_assertions::const_assert_eq!(core::mem::align_of::<WideNode>(), 64);
+static_assertions::const_assert_eq!(core::mem::offset_of!(WideNode, min), 0);
+static_assertions::const_assert_eq!(core::mem::offset_of!(WideNode, max), 48);
 
 impl WideNode {
     /// The `child` value of an unused slot.

@@ -14,13 +14,22 @@ const WIDE_STACK: usize = 3 * MAX_DEPTH as usize + 4;
 /// The slab test's relative padding (see `Aabb::slab_interval`), as a vector.
 const PAD: f32 = 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
-/// A ray prepared for 4-wide box tests: splatted origin and inverse direction, and per axis
-/// whether the near plane is the lower bound.
+/// A ray prepared for 4-wide box tests: splatted origin and inverse direction, and per axis the
+/// row of the node's bounds (see [`planes`]) holding the near and the far planes, chosen once per
+/// ray from the direction's signs.
 struct Ray4 {
     origin: [f32x4; 3],
     inv: [f32x4; 3],
-    near_is_min: [bool; 3],
+    near: [usize; 3],
+    far: [usize; 3],
     t_min: f32x4,
+}
+
+/// A node's bounds as rows: `min` of axes 0 to 2, then `max` of axes 0 to 2 (then `child` and
+/// `count`, which the slab test never reads).
+#[inline(always)]
+fn planes(node: &WideNode) -> &[[f32; 4]; 8] {
+    bytemuck::cast_ref(node)
 }
 
 impl Ray4 {
@@ -30,11 +39,8 @@ impl Ray4 {
         Self {
             origin: [s(ray.origin.x), s(ray.origin.y), s(ray.origin.z)],
             inv: [s(ray.inv_dir.x), s(ray.inv_dir.y), s(ray.inv_dir.z)],
-            near_is_min: [
-                ray.inv_dir.x >= 0.0,
-                ray.inv_dir.y >= 0.0,
-                ray.inv_dir.z >= 0.0,
-            ],
+            near: core::array::from_fn(|k| if ray.inv_dir[k] >= 0.0 { k } else { k + 3 }),
+            far: core::array::from_fn(|k| if ray.inv_dir[k] >= 0.0 { k + 3 } else { k }),
             t_min: s(ray.t_min),
         }
     }
@@ -47,12 +53,10 @@ impl Ray4 {
     fn intersect(&self, node: &WideNode, t_max: f32) -> (f32x4, u32) {
         let mut t_near = self.t_min;
         let mut t_far = f32x4::splat(t_max);
+        let rows = planes(node);
         for k in 0..3 {
-            let (near, far) = if self.near_is_min[k] {
-                (node.min[k], node.max[k])
-            } else {
-                (node.max[k], node.min[k])
-            };
+            // Rows are below 6; the mask only spares the bounds check.
+            let (near, far) = (rows[self.near[k] & 7], rows[self.far[k] & 7]);
             t_near = keep_max(t_near, (f32x4::from(near) - self.origin[k]) * self.inv[k]);
             t_far = keep_min(t_far, (f32x4::from(far) - self.origin[k]) * self.inv[k]);
         }
@@ -93,12 +97,37 @@ fn keep_min(acc: f32x4, t: f32x4) -> f32x4 {
 /// A pending child: node index or first triangle block, triangle count (0 for a node), entry.
 type Entry = (u32, u32, f32);
 
+/// What a traversal counts: [`TraversalStats`] for the `_with_stats` queries, nothing at all for
+/// the plain ones, whose loops then carry no counter updates.
+trait Counters {
+    fn node(&mut self);
+    fn leaf(&mut self, triangles: u32);
+}
+
+impl Counters for TraversalStats {
+    #[inline(always)]
+    fn node(&mut self) {
+        self.inner_nodes += 1;
+    }
+    #[inline(always)]
+    fn leaf(&mut self, triangles: u32) {
+        self.leaves += 1;
+        self.triangles += triangles;
+    }
+}
+
+impl Counters for () {
+    #[inline(always)]
+    fn node(&mut self) {}
+    #[inline(always)]
+    fn leaf(&mut self, _: u32) {}
+}
+
 impl WideBvh {
     /// The closest hit on `[ray.t_min, ray.t_max]`, exactly as the binary BVH and brute force
     /// find it over the triangles the tree was collapsed with.
-    #[inline]
     pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
-        self.closest_hit_with_stats(ray, &mut TraversalStats::default())
+        self.closest(ray, &mut ())
     }
 
     /// [`WideBvh::closest_hit`], adding what it did to `stats` (a wide node counts as one inner
@@ -107,6 +136,11 @@ impl WideBvh {
     /// The loop keeps the node it is in rather than pushing and popping it: a node with one child
     /// hit goes straight on to it, and one with several pushes all but the nearest, farthest first.
     pub fn closest_hit_with_stats(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        self.closest(ray, stats)
+    }
+
+    #[inline(always)]
+    fn closest(&self, ray: &Ray, stats: &mut impl Counters) -> Option<Hit> {
         if self.nodes.is_empty() {
             return None;
         }
@@ -119,7 +153,7 @@ impl WideBvh {
         let (mut child, mut count) = (0u32, 0u32);
         loop {
             if count == 0 {
-                stats.inner_nodes += 1;
+                stats.node();
                 let node = &self.nodes[child as usize];
                 let (t_near, mask) = r.intersect(node, t_max);
                 if mask != 0 {
@@ -130,25 +164,39 @@ impl WideBvh {
                         continue;
                     }
                     let t_near = t_near.to_array();
-                    // Hit children sorted by entry, nearest last.
-                    let mut hits = [(0usize, 0.0f32); 4];
-                    let mut n = 0;
-                    let mut m = mask;
-                    while m != 0 {
-                        let i = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        let mut j = n;
-                        while j > 0 && hits[j - 1].1 < t_near[i] {
-                            hits[j] = hits[j - 1];
-                            j -= 1;
+                    let rest = mask & (mask - 1);
+                    let second = rest.trailing_zeros() as usize;
+                    let (near, far) = if t_near[second] < t_near[first] {
+                        (second, first)
+                    } else {
+                        (first, second)
+                    };
+                    let nearest = if rest & (rest - 1) == 0 {
+                        // Two children hit, the commonest case after one: push the farther.
+                        stack.push((node.child[far], node.count[far], t_near[far]));
+                        near
+                    } else {
+                        // Three or four: sorted by entry, nearest last.
+                        let mut hits =
+                            [(far, t_near[far]), (near, t_near[near]), (0, 0.0), (0, 0.0)];
+                        let mut n = 2;
+                        let mut m = rest & (rest - 1);
+                        while m != 0 {
+                            let i = m.trailing_zeros() as usize;
+                            m &= m - 1;
+                            let mut j = n;
+                            while j > 0 && hits[j - 1].1 < t_near[i] {
+                                hits[j] = hits[j - 1];
+                                j -= 1;
+                            }
+                            hits[j] = (i, t_near[i]);
+                            n += 1;
                         }
-                        hits[j] = (i, t_near[i]);
-                        n += 1;
-                    }
-                    for &(i, t) in &hits[..n - 1] {
-                        stack.push((node.child[i], node.count[i], t));
-                    }
-                    let nearest = hits[n - 1].0;
+                        for &(i, t) in &hits[..n - 1] {
+                            stack.push((node.child[i], node.count[i], t));
+                        }
+                        hits[n - 1].0
+                    };
                     child = node.child[nearest];
                     count = node.count[nearest];
                     continue;
@@ -183,10 +231,9 @@ impl WideBvh {
         ray: &RayTri4,
         best: &mut Option<Hit>,
         t_max: &mut f32,
-        stats: &mut TraversalStats,
+        stats: &mut impl Counters,
     ) {
-        stats.leaves += 1;
-        stats.triangles += count;
+        stats.leaf(count);
         let first = first as usize;
         for block in &self.tris[first..first + count.div_ceil(4) as usize] {
             let h = block.intersect(ray, *t_max);
@@ -209,13 +256,17 @@ impl WideBvh {
     }
 
     /// True when any triangle is hit on the segment; stops at the first hit.
-    #[inline]
     pub fn any_hit(&self, ray: &Ray) -> bool {
-        self.any_hit_with_stats(ray, &mut TraversalStats::default())
+        self.any(ray, &mut ())
     }
 
     /// [`WideBvh::any_hit`], adding what it did to `stats`.
     pub fn any_hit_with_stats(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        self.any(ray, stats)
+    }
+
+    #[inline(always)]
+    fn any(&self, ray: &Ray, stats: &mut impl Counters) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
@@ -225,7 +276,7 @@ impl WideBvh {
         let (mut child, mut count) = (0u32, 0u32);
         loop {
             if count == 0 {
-                stats.inner_nodes += 1;
+                stats.node();
                 let node = &self.nodes[child as usize];
                 let (_, mut mask) = r.intersect(node, ray.t_max);
                 if mask != 0 {
@@ -242,8 +293,7 @@ impl WideBvh {
                     continue;
                 }
             } else {
-                stats.leaves += 1;
-                stats.triangles += count;
+                stats.leaf(count);
                 let first = child as usize;
                 for block in &self.tris[first..first + count.div_ceil(4) as usize] {
                     if block.any_hit(&rt, ray.t_max) {

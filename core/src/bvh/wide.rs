@@ -80,8 +80,8 @@ const MERGE_RATIO: f32 = 0.5;
 
 /// A 4-wide BVH with its own copy of the triangles, in leaf order and laid out for the 4-wide
 /// triangle test ([`Triangle4`] blocks: a leaf tests four triangles per step, with no indirection
-/// through a primitive-index array). The root is node 0; a BVH whose binary root is a leaf (or a
-/// subtree of at most four triangles) gets a root with that leaf as its only child.
+/// through a primitive-index array). The root is node 0; a BVH whose binary root becomes a leaf
+/// (see [`WideBvh::from_binary`]) gets a root with that leaf as its only child.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct WideBvh {
     pub(crate) nodes: Vec<WideNode>,
@@ -94,8 +94,9 @@ impl WideBvh {
     /// Collapses a binary BVH built over `tris`: each wide node takes a binary node's children and
     /// keeps opening the inner child of largest surface area (the one a ray is likeliest to enter)
     /// until it has four. A binary subtree of at most four triangles becomes one leaf of one
-    /// [`Triangle4`] block; a larger binary leaf becomes a leaf of consecutive blocks. Depth never
-    /// grows. Ids missing from `tris` are dropped, as the binary traversal skips them.
+    /// [`Triangle4`] block, one of five to eight a leaf of two blocks when [`MERGE_RATIO`] says
+    /// splitting it saves little, and a larger binary leaf a leaf of consecutive blocks. Depth
+    /// never grows. Ids missing from `tris` are dropped, as the binary traversal skips them.
     pub fn from_binary(bvh: &Bvh, tris: &[Triangle]) -> Self {
         let mut out = WideBvh {
             nodes: Vec::with_capacity(bvh.nodes.len() / 4 + 1),

@@ -68,7 +68,7 @@ fn run(u: &mut Unstructured) -> Result<()> {
 
     for (what, bvh, max_depth) in &built {
         check_tree(bvh, &tris, *max_depth, what);
-        let wide = WideBvh::from_binary(bvh);
+        let wide = WideBvh::from_binary(bvh, &tris);
         assert!(wide.max_depth() <= MAX_DEPTH, "{what}: wide depth");
         for ray in &rays {
             check_queries(bvh, &wide, &tris, ray, what);

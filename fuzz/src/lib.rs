@@ -346,12 +346,12 @@ pub fn check_queries(bvh: &Bvh, wide: &WideBvh, tris: &[Triangle], ray: &Ray, wh
     );
     assert!(all.triangles >= all.hits, "{what}: {all:?}");
     assert_eq!(
-        wide.closest_hit(ray, tris),
+        wide.closest_hit(ray),
         expect,
         "{what}: wide closest hit, {ray:?}"
     );
     assert_eq!(
-        wide.any_hit(ray, tris),
+        wide.any_hit(ray),
         any,
         "{what}: wide any hit, {ray:?}"
     );

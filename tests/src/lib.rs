@@ -10,7 +10,7 @@
 use std::path::PathBuf;
 
 use rdbvh_core::brute_force;
-use rdbvh_core::bvh::{AllHitStats, Bvh, Hit, TraversalStats};
+use rdbvh_core::bvh::{AllHitStats, Bvh, Hit, TraversalStats, WideBvh};
 use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 use rdbvh_core::Vec3;
 
@@ -279,6 +279,75 @@ pub fn check_ray_consistency(bvh: &Bvh, tris: &[Triangle], ray: &Ray) -> Option<
     let all = bvh.all_hit(ray, tris);
     check_traversal_consistency(bvh, tris, ray, (closest, &cs), (any, &anys), &all);
     closest
+}
+
+/// Checks the 4-wide collapse of a tree over `tris` against the answer every traversal must give
+/// (`expect`, the brute-force closest hit): closest hit exactly, any hit consistent, NaN-free
+/// hits, and counters within the collapsed tree's size. Returns the closest hit.
+///
+/// # Panics
+/// When the wide tree disagrees.
+pub fn check_wide_ray(wide: &WideBvh, tris: &[Triangle], ray: &Ray, expect: Option<Hit>) {
+    let mut cs = TraversalStats::default();
+    let got = wide.closest_hit_with_stats(ray, &mut cs);
+    assert_eq!(got, expect, "wide closest hit differs for {ray:?}");
+    assert_eq!(wide.closest_hit(ray), got);
+    if let Some(h) = got {
+        assert!(
+            h.t.is_finite() && h.u.is_finite() && h.v.is_finite(),
+            "wide hit {h:?} for {ray:?}"
+        );
+    }
+    let mut anys = TraversalStats::default();
+    let any = wide.any_hit_with_stats(ray, &mut anys);
+    assert_eq!(any, expect.is_some(), "wide any hit differs for {ray:?}");
+    assert_eq!(wide.any_hit(ray), any);
+    for s in [cs, anys] {
+        assert!(
+            s.inner_nodes as usize <= wide.nodes().len(),
+            "{s:?} for {ray:?}"
+        );
+        assert!(s.triangles as usize <= tris.len(), "{s:?} for {ray:?}");
+    }
+}
+
+/// Checks the structure of a 4-wide collapse of `bvh` over `tris`: every triangle in exactly one
+/// lane of one leaf, unused lanes empty, leaf boxes holding their triangles, and depth no deeper
+/// than the binary tree's.
+///
+/// # Panics
+/// When the wide tree is malformed.
+pub fn check_wide_structure(wide: &WideBvh, bvh: &Bvh, tris: &[Triangle]) {
+    assert!(wide.max_depth() <= bvh.max_depth());
+    let mut seen = vec![false; tris.len()];
+    let blocks = wide.triangles();
+    for node in wide.nodes() {
+        for i in 0..4 {
+            if node.child[i] == rdbvh_core::bvh::WideNode::EMPTY || node.count[i] == 0 {
+                continue;
+            }
+            let (first, count) = (node.child[i] as usize, node.count[i] as usize);
+            let bounds = node.child_bounds(i);
+            for k in 0..count.div_ceil(4) * 4 {
+                let block = &blocks[first + k / 4];
+                let lane = k % 4;
+                let id = block.id[lane];
+                if k >= count {
+                    assert_eq!(id, rdbvh_core::geometry::Triangle4::UNUSED_ID);
+                    continue;
+                }
+                assert!(
+                    !std::mem::replace(&mut seen[id as usize], true),
+                    "{id} twice"
+                );
+                let tri = &tris[id as usize];
+                assert!(bounds.contains_box(&tri.bounds()), "{id} outside its leaf");
+                let v0 = Vec3::new(block.v0[0][lane], block.v0[1][lane], block.v0[2][lane]);
+                assert_eq!(v0, tri.v0);
+            }
+        }
+    }
+    assert!(seen.iter().all(|&s| s), "a triangle is in no leaf");
 }
 
 /// Counters of one closest-hit or any-hit query: within the tree's size, leaves visited only if

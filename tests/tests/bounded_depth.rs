@@ -113,12 +113,12 @@ fn check(name: &str, what: &str, bvh: &Bvh, tris: &[Triangle], max_depth: u32, r
     if let Err(e) = bvh.validate(tris.len(), |i| tris[i as usize].bounds()) {
         panic!("{name}, {what}: {e}");
     }
-    let wide = WideBvh::from_binary(bvh);
+    let wide = WideBvh::from_binary(bvh, tris);
     assert!(wide.max_depth() <= MAX_DEPTH, "{name}, {what}: wide depth");
     check_rays(bvh, tris, rays);
     for ray in rays {
         assert_eq!(
-            wide.closest_hit(ray, tris),
+            wide.closest_hit(ray),
             rdbvh_core::brute_force::closest_hit(ray, tris),
             "{name}, {what}: wide"
         );

@@ -10,13 +10,15 @@ use proptest::prelude::*;
 use proptest::sample::Index;
 use rdbvh_core::brute_force;
 use rdbvh_core::build::{BinSpace, BuildArena, BuildConfig, Builder, CutEvaluation, ThesisCut};
-use rdbvh_core::bvh::Bvh;
+use rdbvh_core::bvh::{Bvh, WideBvh};
 use rdbvh_core::geometry::{Ray, RayError, Triangle};
 use rdbvh_core::heuristics::{
     AllAxes, AxisChooser, CostModel, LeafSize, LongestAxis, Sah, SahTermination, Termination,
 };
 use rdbvh_core::{BuildError, Vec3};
-use rdbvh_tests::{check_ray, check_structure, known_core_bug};
+use rdbvh_tests::{
+    check_ray, check_structure, check_wide_ray, check_wide_structure, known_core_bug,
+};
 
 /// Cases per property: `PROPTEST_CASES` when set, else `default`.
 fn cases(default: u32) -> u32 {
@@ -240,8 +242,11 @@ fn check_builder<A: AxisChooser, C: CostModel, T: Termination>(
     assert_eq!(stats.nodes as usize, bvh.nodes().len());
     assert_eq!(stats.leaves as usize, bvh.leaf_count());
     assert_eq!(stats.max_depth, bvh.max_depth());
+    let wide = WideBvh::from_binary(&bvh, tris);
+    check_wide_structure(&wide, &bvh, tris);
     for ray in rays {
-        check_ray(&bvh, tris, ray);
+        let expect = check_ray(&bvh, tris, ray);
+        check_wide_ray(&wide, tris, ray, expect);
     }
     bvh
 }
@@ -474,8 +479,11 @@ fn axis_parallel_rays_on_a_box_of_walls() {
     }
     for bvh in &builders_bvhs {
         check_structure(bvh, &tris);
+        let wide = WideBvh::from_binary(bvh, &tris);
+        check_wide_structure(&wide, bvh, &tris);
         for ray in &rays {
-            check_ray(bvh, &tris, ray);
+            let expect = check_ray(bvh, &tris, ray);
+            check_wide_ray(&wide, &tris, ray, expect);
             if ray.t_min > ray.t_max {
                 assert_eq!(
                     bvh.closest_hit(ray, &tris),

@@ -12,11 +12,11 @@ use std::path::Path;
 
 use rdbvh::scene::Scene;
 use rdbvh_core::build::{BuildArena, Builder};
-use rdbvh_core::bvh::Bvh;
+use rdbvh_core::bvh::{Bvh, WideBvh};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_tests::{
-    camera_rays, check_ray_against, check_ray_consistency, check_structure, interior_rays,
-    require_scene, require_shared, scene_bounds, Oracle,
+    camera_rays, check_ray_against, check_ray_consistency, check_structure, check_wide_ray,
+    check_wide_structure, interior_rays, require_scene, require_shared, scene_bounds, Oracle,
 };
 
 /// Triangle tests the oracle may spend per scene (each ray costs about `3 * triangles`).
@@ -120,12 +120,16 @@ fn run_scene(relative: &str, rays_per_kind: usize) -> Option<Report> {
         rays: rays.len(),
         ..Report::default()
     };
+    // The 4-wide collapse of the SAH tree, with its own leaf-ordered triangle blocks.
+    let wide = WideBvh::from_binary(&sah, tris);
+    check_wide_structure(&wide, &sah, tris);
     for (i, ray) in rays.iter().enumerate() {
         if i % stride == 0 {
             let oracle = Oracle::new(ray, tris);
             for bvh in [&sah, &lsph] {
                 check_ray_against(bvh, tris, ray, &oracle);
             }
+            check_wide_ray(&wide, tris, ray, oracle.closest);
             report.oracle_rays += 1;
             report.hits += usize::from(oracle.closest.is_some());
         } else {
@@ -133,6 +137,7 @@ fn run_scene(relative: &str, rays_per_kind: usize) -> Option<Report> {
             let b = check_ray_consistency(&lsph, tris, ray);
             // Two valid BVHs over the same triangles give the same exact closest hit.
             assert_eq!(a, b, "{relative}: SAH and LSPH disagree for {ray:?}");
+            check_wide_ray(&wide, tris, ray, a);
         }
     }
     // The rays were aimed at the scene: a test that hits nothing proves little.

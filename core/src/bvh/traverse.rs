@@ -357,15 +357,15 @@ mod tests {
     fn traversals_of_a_small_tree() {
         let tris = crate::test_scenes::soup(24, 5, 0.0, 4.0, 1.0);
         let bvh = Builder::sah().build(&tris).unwrap();
-        let wide = crate::bvh::WideBvh::from_binary(&bvh);
+        let wide = crate::bvh::WideBvh::from_binary(&bvh, &tris);
         for i in 0..16 {
             let o = Vec3::new(-1.0, (i % 4) as f32, (i / 4) as f32);
             let ray = Ray::new(o, Vec3::new(1.0, 0.1, 0.05)).unwrap();
             let expect = brute_force::closest_hit(&ray, &tris);
             assert_eq!(bvh.closest_hit(&ray, &tris), expect);
-            assert_eq!(wide.closest_hit(&ray, &tris), expect);
+            assert_eq!(wide.closest_hit(&ray), expect);
             assert_eq!(bvh.any_hit(&ray, &tris), expect.is_some());
-            assert_eq!(wide.any_hit(&ray, &tris), expect.is_some());
+            assert_eq!(wide.any_hit(&ray), expect.is_some());
             assert_eq!(
                 bvh.all_hit(&ray, &tris).hits,
                 brute_force::hit_count(&ray, &tris)

@@ -2,10 +2,10 @@
 
 use wide::f32x4;
 
-use super::traverse::{any_prim, test_prims, Stack};
+use super::traverse::Stack;
 use super::wide::{WideBvh, WideNode};
 use super::{Hit, TraversalStats, MAX_DEPTH};
-use crate::geometry::{pad_far, Ray, Triangle};
+use crate::geometry::{pad_far, Ray, RayTri4};
 
 /// Each visited node pops one entry and pushes at most four, so pending entries grow by at most
 /// three per level of the (at most [`MAX_DEPTH`] deep) tree.
@@ -14,13 +14,22 @@ const WIDE_STACK: usize = 3 * MAX_DEPTH as usize + 4;
 /// The slab test's relative padding (see `Aabb::slab_interval`), as a vector.
 const PAD: f32 = 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
-/// A ray prepared for 4-wide box tests: splatted origin and inverse direction, and per axis
-/// whether the near plane is the lower bound.
+/// A ray prepared for 4-wide box tests: splatted origin and inverse direction, and per axis the
+/// row of the node's bounds (see [`planes`]) holding the near and the far planes, chosen once per
+/// ray from the direction's signs.
 struct Ray4 {
     origin: [f32x4; 3],
     inv: [f32x4; 3],
-    near_is_min: [bool; 3],
+    near: [usize; 3],
+    far: [usize; 3],
     t_min: f32x4,
+}
+
+/// A node's bounds as rows: `min` of axes 0 to 2, then `max` of axes 0 to 2 (then `child` and
+/// `count`, which the slab test never reads).
+#[inline(always)]
+fn planes(node: &WideNode) -> &[[f32; 4]; 8] {
+    bytemuck::cast_ref(node)
 }
 
 impl Ray4 {
@@ -30,11 +39,8 @@ impl Ray4 {
         Self {
             origin: [s(ray.origin.x), s(ray.origin.y), s(ray.origin.z)],
             inv: [s(ray.inv_dir.x), s(ray.inv_dir.y), s(ray.inv_dir.z)],
-            near_is_min: [
-                ray.inv_dir.x >= 0.0,
-                ray.inv_dir.y >= 0.0,
-                ray.inv_dir.z >= 0.0,
-            ],
+            near: core::array::from_fn(|k| if ray.inv_dir[k] >= 0.0 { k } else { k + 3 }),
+            far: core::array::from_fn(|k| if ray.inv_dir[k] >= 0.0 { k + 3 } else { k }),
             t_min: s(ray.t_min),
         }
     }
@@ -47,12 +53,10 @@ impl Ray4 {
     fn intersect(&self, node: &WideNode, t_max: f32) -> (f32x4, u32) {
         let mut t_near = self.t_min;
         let mut t_far = f32x4::splat(t_max);
+        let rows = planes(node);
         for k in 0..3 {
-            let (near, far) = if self.near_is_min[k] {
-                (node.min[k], node.max[k])
-            } else {
-                (node.max[k], node.min[k])
-            };
+            // Rows are below 6; the mask only spares the bounds check.
+            let (near, far) = (rows[self.near[k] & 7], rows[self.far[k] & 7]);
             t_near = keep_max(t_near, (f32x4::from(near) - self.origin[k]) * self.inv[k]);
             t_far = keep_min(t_far, (f32x4::from(far) - self.origin[k]) * self.inv[k]);
         }
@@ -90,114 +94,219 @@ fn keep_min(acc: f32x4, t: f32x4) -> f32x4 {
     }
 }
 
-/// A pending child: node index or first primitive slot, primitive count (0 for a node), entry.
+/// A pending child: node index or first triangle block, triangle count (0 for a node), entry.
 type Entry = (u32, u32, f32);
+
+/// What a traversal counts: [`TraversalStats`] for the `_with_stats` queries, nothing at all for
+/// the plain ones, whose loops then carry no counter updates.
+trait Counters {
+    fn node(&mut self);
+    fn leaf(&mut self, triangles: u32);
+}
+
+impl Counters for TraversalStats {
+    #[inline(always)]
+    fn node(&mut self) {
+        self.inner_nodes += 1;
+    }
+    #[inline(always)]
+    fn leaf(&mut self, triangles: u32) {
+        self.leaves += 1;
+        self.triangles += triangles;
+    }
+}
+
+impl Counters for () {
+    #[inline(always)]
+    fn node(&mut self) {}
+    #[inline(always)]
+    fn leaf(&mut self, _: u32) {}
+}
 
 impl WideBvh {
     /// The closest hit on `[ray.t_min, ray.t_max]`, exactly as the binary BVH and brute force
-    /// find it.
-    #[inline]
-    pub fn closest_hit(&self, ray: &Ray, tris: &[Triangle]) -> Option<Hit> {
-        self.closest_hit_with_stats(ray, tris, &mut TraversalStats::default())
+    /// find it over the triangles the tree was collapsed with.
+    pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        self.closest(ray, &mut ())
     }
 
     /// [`WideBvh::closest_hit`], adding what it did to `stats` (a wide node counts as one inner
-    /// node).
-    pub fn closest_hit_with_stats(
-        &self,
-        ray: &Ray,
-        tris: &[Triangle],
-        stats: &mut TraversalStats,
-    ) -> Option<Hit> {
+    /// node, a leaf's triangles as tested whatever their lanes decide).
+    ///
+    /// The loop keeps the node it is in rather than pushing and popping it: a node with one child
+    /// hit goes straight on to it, and one with several pushes all but the nearest, farthest first.
+    pub fn closest_hit_with_stats(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        self.closest(ray, stats)
+    }
+
+    #[inline(always)]
+    fn closest(&self, ray: &Ray, stats: &mut impl Counters) -> Option<Hit> {
         if self.nodes.is_empty() {
             return None;
         }
         let r = Ray4::new(ray);
+        let rt = RayTri4::new(ray);
         let mut best: Option<Hit> = None;
+        // The segment's end: the closest hit so far, else `ray.t_max`.
+        let mut t_max = ray.t_max;
         let mut stack: Stack<Entry, WIDE_STACK> = Stack::new();
-        stack.push((0, 0, ray.t_min));
-        while let Some((child, count, t_entry)) = stack.pop() {
-            if best.is_some_and(|b| t_entry > pad_far(b.t)) {
-                continue;
-            }
-            if count > 0 {
-                let first = child as usize;
-                test_prims(
-                    &self.prim_indices[first..first + count as usize],
-                    ray,
-                    tris,
-                    &mut best,
-                    stats,
-                );
-                continue;
-            }
-            stats.inner_nodes += 1;
-            let node = &self.nodes[child as usize];
-            let (t_near, mut mask) = r.intersect(node, best.map_or(ray.t_max, |h| h.t));
-            let t_near = t_near.to_array();
-            // Hit children sorted by entry, nearest last, so it is popped first.
-            let mut hits = [(0usize, 0.0f32); 4];
-            let mut n = 0;
-            while mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                let mut j = n;
-                while j > 0 && hits[j - 1].1 < t_near[i] {
-                    hits[j] = hits[j - 1];
-                    j -= 1;
+        let (mut child, mut count) = (0u32, 0u32);
+        loop {
+            if count == 0 {
+                stats.node();
+                let node = &self.nodes[child as usize];
+                let (t_near, mask) = r.intersect(node, t_max);
+                if mask != 0 {
+                    let first = mask.trailing_zeros() as usize;
+                    if mask & (mask - 1) == 0 {
+                        child = node.child[first];
+                        count = node.count[first];
+                        continue;
+                    }
+                    let t_near = t_near.to_array();
+                    let rest = mask & (mask - 1);
+                    let second = rest.trailing_zeros() as usize;
+                    let (near, far) = if t_near[second] < t_near[first] {
+                        (second, first)
+                    } else {
+                        (first, second)
+                    };
+                    let nearest = if rest & (rest - 1) == 0 {
+                        // Two children hit, the commonest case after one: push the farther.
+                        stack.push((node.child[far], node.count[far], t_near[far]));
+                        near
+                    } else {
+                        // Three or four: sorted by entry, nearest last.
+                        let mut hits =
+                            [(far, t_near[far]), (near, t_near[near]), (0, 0.0), (0, 0.0)];
+                        let mut n = 2;
+                        let mut m = rest & (rest - 1);
+                        while m != 0 {
+                            let i = m.trailing_zeros() as usize;
+                            m &= m - 1;
+                            let mut j = n;
+                            while j > 0 && hits[j - 1].1 < t_near[i] {
+                                hits[j] = hits[j - 1];
+                                j -= 1;
+                            }
+                            hits[j] = (i, t_near[i]);
+                            n += 1;
+                        }
+                        for &(i, t) in &hits[..n - 1] {
+                            stack.push((node.child[i], node.count[i], t));
+                        }
+                        hits[n - 1].0
+                    };
+                    child = node.child[nearest];
+                    count = node.count[nearest];
+                    continue;
                 }
-                hits[j] = (i, t_near[i]);
-                n += 1;
+            } else {
+                self.leaf_closest(child, count, &rt, &mut best, &mut t_max, stats);
             }
-            for &(i, t) in &hits[..n] {
-                stack.push((node.child[i], node.count[i], t));
+            // Pop the next subtree that can still hold a closer hit: the same padded bound the box
+            // test used when it admitted the subtree.
+            loop {
+                let Some((c, n, t_entry)) = stack.pop() else {
+                    return best;
+                };
+                if t_entry <= pad_far(t_max) {
+                    child = c;
+                    count = n;
+                    break;
+                }
             }
         }
-        best
+    }
+
+    /// Tests the `count` triangles of the leaf whose blocks start at `first`, keeping the closest
+    /// hit in `best` and its distance in `t_max`. Every lane hit in a block lies within the
+    /// segment as it was before the block, so the closest of them under the tie rule, compared
+    /// with `best`, is what the scalar loop (which shortens the segment after each hit) finds.
+    #[inline(always)]
+    fn leaf_closest(
+        &self,
+        first: u32,
+        count: u32,
+        ray: &RayTri4,
+        best: &mut Option<Hit>,
+        t_max: &mut f32,
+        stats: &mut impl Counters,
+    ) {
+        stats.leaf(count);
+        let first = first as usize;
+        for block in &self.tris[first..first + count.div_ceil(4) as usize] {
+            let h = block.intersect(ray, *t_max);
+            let mut m = h.mask;
+            while m != 0 {
+                let j = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let hit = Hit {
+                    t: h.t[j],
+                    triangle: block.id[j],
+                    u: h.u[j],
+                    v: h.v[j],
+                };
+                if best.is_none_or(|b| hit.is_closer_than(&b)) {
+                    *best = Some(hit);
+                    *t_max = hit.t;
+                }
+            }
+        }
     }
 
     /// True when any triangle is hit on the segment; stops at the first hit.
-    #[inline]
-    pub fn any_hit(&self, ray: &Ray, tris: &[Triangle]) -> bool {
-        self.any_hit_with_stats(ray, tris, &mut TraversalStats::default())
+    pub fn any_hit(&self, ray: &Ray) -> bool {
+        self.any(ray, &mut ())
     }
 
     /// [`WideBvh::any_hit`], adding what it did to `stats`.
-    pub fn any_hit_with_stats(
-        &self,
-        ray: &Ray,
-        tris: &[Triangle],
-        stats: &mut TraversalStats,
-    ) -> bool {
+    pub fn any_hit_with_stats(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        self.any(ray, stats)
+    }
+
+    #[inline(always)]
+    fn any(&self, ray: &Ray, stats: &mut impl Counters) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
         let r = Ray4::new(ray);
+        let rt = RayTri4::new(ray);
         let mut stack: Stack<(u32, u32), WIDE_STACK> = Stack::new();
-        stack.push((0, 0));
-        while let Some((child, count)) = stack.pop() {
-            if count > 0 {
-                let first = child as usize;
-                if any_prim(
-                    &self.prim_indices[first..first + count as usize],
-                    ray,
-                    tris,
-                    stats,
-                ) {
-                    return true;
+        let (mut child, mut count) = (0u32, 0u32);
+        loop {
+            if count == 0 {
+                stats.node();
+                let node = &self.nodes[child as usize];
+                let (_, mut mask) = r.intersect(node, ray.t_max);
+                if mask != 0 {
+                    // Any hit needs no order: go on to the first child hit, push the others.
+                    let first = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    while mask != 0 {
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        stack.push((node.child[i], node.count[i]));
+                    }
+                    child = node.child[first];
+                    count = node.count[first];
+                    continue;
                 }
-                continue;
+            } else {
+                stats.leaf(count);
+                let first = child as usize;
+                for block in &self.tris[first..first + count.div_ceil(4) as usize] {
+                    if block.any_hit(&rt, ray.t_max) {
+                        return true;
+                    }
+                }
             }
-            stats.inner_nodes += 1;
-            let node = &self.nodes[child as usize];
-            let (_, mut mask) = r.intersect(node, ray.t_max);
-            while mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                stack.push((node.child[i], node.count[i]));
-            }
+            let Some((c, n)) = stack.pop() else {
+                return false;
+            };
+            child = c;
+            count = n;
         }
-        false
     }
 }
 
@@ -210,6 +319,7 @@ mod tests {
     use crate::brute_force;
     use crate::build::Builder;
     use crate::bvh::Bvh;
+    use crate::geometry::Triangle;
     use crate::random::Pcg32;
 
     #[test]
@@ -226,7 +336,7 @@ mod tests {
         for n in [1usize, 2, 5, tris.len()] {
             let tris = &tris[..n];
             let bvh = Builder::sah().build(tris).unwrap();
-            let wide = WideBvh::from_binary(&bvh);
+            let wide = WideBvh::from_binary(&bvh, tris);
             assert!(wide.max_depth() <= bvh.max_depth());
             for i in 0..2000 {
                 let o = v(12.0);
@@ -240,32 +350,29 @@ mod tests {
                     let Ok(r) = Ray::new(o, Vec3::new(d.x, d.y, 0.0)) else {
                         continue;
                     };
-                    assert_eq!(
-                        wide.closest_hit(&r, tris),
-                        brute_force::closest_hit(&r, tris)
-                    );
+                    assert_eq!(wide.closest_hit(&r), brute_force::closest_hit(&r, tris));
                     continue;
                 }
                 let Ok(r) = Ray::new(o, d) else { continue };
                 let expect = brute_force::closest_hit(&r, tris);
-                assert_eq!(wide.closest_hit(&r, tris), expect, "ray {i}");
-                assert_eq!(wide.any_hit(&r, tris), expect.is_some());
+                assert_eq!(wide.closest_hit(&r), expect, "ray {i}");
+                assert_eq!(wide.any_hit(&r), expect.is_some());
             }
         }
     }
 
     #[test]
     fn empty_and_single_leaf() {
-        let wide = WideBvh::from_binary(&Bvh::default());
+        let wide = WideBvh::from_binary(&Bvh::default(), &[]);
         let r = Ray::new(Vec3::ZERO, Vec3::Z).unwrap();
-        assert!(wide.closest_hit(&r, &[]).is_none());
+        assert!(wide.closest_hit(&r).is_none());
         let t = [Triangle::new(
             Vec3::new(-1.0, -1.0, 1.0),
             Vec3::new(1.0, -1.0, 1.0),
             Vec3::new(0.0, 1.0, 1.0),
         )];
-        let wide = WideBvh::from_binary(&Builder::sah().build(&t).unwrap());
-        assert_eq!(wide.closest_hit(&r, &t).unwrap().triangle, 0);
-        assert!(wide.any_hit(&r, &t));
+        let wide = WideBvh::from_binary(&Builder::sah().build(&t).unwrap(), &t);
+        assert_eq!(wide.closest_hit(&r).unwrap().triangle, 0);
+        assert!(wide.any_hit(&r));
     }
 }

@@ -11,6 +11,7 @@ mod projection;
 mod ray;
 mod solid_angle;
 mod triangle;
+mod triangle4;
 
 pub(crate) use aabb::pad_far;
 pub use aabb::Aabb;
@@ -23,3 +24,4 @@ pub use projection::{box_corner, orthographic_silhouette, perspective_silhouette
 pub use ray::{Ray, RayError};
 pub use solid_angle::{box_solid_angle4, box_solid_angle_far4, far_field4, FAR_FIELD};
 pub use triangle::{Triangle, TriangleHit};
+pub use triangle4::{Hits4, RayTri4, Triangle4};

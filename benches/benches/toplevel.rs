@@ -167,7 +167,7 @@ fn query(c: &mut Criterion<Clock>) {
                 continue;
             }
         };
-        let wide = scene.clone().widen();
+        let wide = scene.clone().widen(&tris);
         let short_name = name.rsplit('/').next().unwrap_or(name);
         for (kind, area) in [("plane", plane), ("point", point)] {
             let mut sampler = RaySampler::new(area, RAY_SEED);
@@ -208,7 +208,7 @@ fn query(c: &mut Criterion<Clock>) {
                 bench.iter(|| {
                     black_box(&rays)
                         .iter()
-                        .filter(|r| fallback.closest_hit(r, &tris).is_some())
+                        .filter(|r| fallback.closest_hit(r).is_some())
                         .count()
                 })
             });

@@ -55,6 +55,8 @@ fn run(u: &mut Unstructured) -> Result<()> {
         ),
     };
     assert_eq!(octree.areas().len(), areas.len());
+    // The same scene over 4-wide trees must answer the same.
+    let wide = octree.clone().widen(&tris);
 
     // Rays each area models (affine, so the local BVHs answer), with jitter, and arbitrary ones.
     let mut rays: Vec<Ray> = Vec::new();
@@ -98,6 +100,8 @@ fn run(u: &mut Unstructured) -> Result<()> {
         assert_eq!(list.closest_hit(ray, &tris), expect, "list scene, {case}");
         assert_eq!(octree.any_hit(ray, &tris), any, "octree scene any, {ray:?}");
         assert_eq!(list.any_hit(ray, &tris), any, "list scene any, {ray:?}");
+        assert_eq!(wide.closest_hit(ray, &tris), expect, "wide scene, {case}");
+        assert_eq!(wide.any_hit(ray, &tris), any, "wide scene any, {ray:?}");
     }
 
     // Octree conservativeness, on points strictly inside some area (vertex averages, sampled

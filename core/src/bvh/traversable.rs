@@ -3,7 +3,7 @@
 //! dispatched.
 
 use super::{Bvh, Hit, TraversalStats, WideBvh};
-use crate::geometry::{Ray, Triangle};
+use crate::geometry::{Ray, Triangle, Triangle4};
 
 /// Closest-hit and any-hit queries over the triangles a hierarchy was built from, with the work
 /// counted, and its size. Implemented by [`Bvh`] and [`WideBvh`]; both answer exactly as brute
@@ -52,24 +52,35 @@ impl Traversable for Bvh {
     }
 }
 
+/// The wide tree answers from its own copy of the triangles (made by [`WideBvh::from_binary`]
+/// from the array the scene passes here), so it ignores `tris`.
 impl Traversable for WideBvh {
     #[inline]
     fn closest_hit_with_stats(
         &self,
         ray: &Ray,
-        tris: &[Triangle],
+        _tris: &[Triangle],
         stats: &mut TraversalStats,
     ) -> Option<Hit> {
-        WideBvh::closest_hit_with_stats(self, ray, tris, stats)
+        WideBvh::closest_hit_with_stats(self, ray, stats)
     }
 
     #[inline]
-    fn any_hit_with_stats(&self, ray: &Ray, tris: &[Triangle], stats: &mut TraversalStats) -> bool {
-        WideBvh::any_hit_with_stats(self, ray, tris, stats)
+    fn any_hit_with_stats(
+        &self,
+        ray: &Ray,
+        _tris: &[Triangle],
+        stats: &mut TraversalStats,
+    ) -> bool {
+        WideBvh::any_hit_with_stats(self, ray, stats)
     }
 
     fn prim_count(&self) -> usize {
-        self.prim_indices().len()
+        self.triangles()
+            .iter()
+            .flat_map(|b| b.id)
+            .filter(|&id| id != Triangle4::UNUSED_ID)
+            .count()
     }
 
     fn memory_bytes(&self) -> usize {

@@ -177,12 +177,17 @@ impl<L: AreaLookup> Scene<L> {
     }
 
     /// The same scene with every local and the fallback BVH collapsed to 4-wide nodes
-    /// ([`WideBvh::from_binary`]): same areas, lookup and answers, faster queries.
-    pub fn widen(self) -> Scene<L, WideBvh> {
+    /// ([`WideBvh::from_binary`], each with its own copy of its triangles from `tris`, the array
+    /// the scene was built over): same areas, lookup and answers, faster queries.
+    pub fn widen(self, tris: &[Triangle]) -> Scene<L, WideBvh> {
         Scene {
             areas: self.areas,
-            local: self.local.iter().map(WideBvh::from_binary).collect(),
-            fallback: WideBvh::from_binary(&self.fallback),
+            local: self
+                .local
+                .iter()
+                .map(|b| WideBvh::from_binary(b, tris))
+                .collect(),
+            fallback: WideBvh::from_binary(&self.fallback, tris),
             lookup: self.lookup,
             max_tries: self.max_tries,
         }
@@ -436,7 +441,7 @@ mod tests {
         let options = SceneOptions::default();
         let octree = Scene::with_octree(&tris, areas(), &options, 5).unwrap();
         let list = Scene::with_list(&tris, areas(), &options).unwrap();
-        let wide = octree.clone().widen();
+        let wide = octree.clone().widen(&tris);
         assert_eq!(wide.triangles_per_area(), octree.triangles_per_area());
         let mut rng = Pcg32::new(4);
         let (mut local_answers, mut wide_local_answers) = (0, 0);

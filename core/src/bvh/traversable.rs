@@ -20,6 +20,16 @@ pub trait Traversable {
     /// True when anything is hit on the segment, adding the work to `stats`.
     fn any_hit_with_stats(&self, ray: &Ray, tris: &[Triangle], stats: &mut TraversalStats) -> bool;
 
+    /// The closest hit, without counting (the implementations' counters then compile away).
+    fn closest_hit(&self, ray: &Ray, tris: &[Triangle]) -> Option<Hit> {
+        self.closest_hit_with_stats(ray, tris, &mut TraversalStats::default())
+    }
+
+    /// True when anything is hit, without counting.
+    fn any_hit(&self, ray: &Ray, tris: &[Triangle]) -> bool {
+        self.any_hit_with_stats(ray, tris, &mut TraversalStats::default())
+    }
+
     /// How many primitives the hierarchy holds.
     fn prim_count(&self) -> usize;
 
@@ -41,6 +51,16 @@ impl Traversable for Bvh {
     #[inline]
     fn any_hit_with_stats(&self, ray: &Ray, tris: &[Triangle], stats: &mut TraversalStats) -> bool {
         Bvh::any_hit_with_stats(self, ray, tris, stats)
+    }
+
+    #[inline]
+    fn closest_hit(&self, ray: &Ray, tris: &[Triangle]) -> Option<Hit> {
+        Bvh::closest_hit(self, ray, tris)
+    }
+
+    #[inline]
+    fn any_hit(&self, ray: &Ray, tris: &[Triangle]) -> bool {
+        Bvh::any_hit(self, ray, tris)
     }
 
     fn prim_count(&self) -> usize {
@@ -73,6 +93,16 @@ impl Traversable for WideBvh {
         stats: &mut TraversalStats,
     ) -> bool {
         WideBvh::any_hit_with_stats(self, ray, stats)
+    }
+
+    #[inline]
+    fn closest_hit(&self, ray: &Ray, _tris: &[Triangle]) -> Option<Hit> {
+        WideBvh::closest_hit(self, ray)
+    }
+
+    #[inline]
+    fn any_hit(&self, ray: &Ray, _tris: &[Triangle]) -> bool {
+        WideBvh::any_hit(self, ray)
     }
 
     fn prim_count(&self) -> usize {

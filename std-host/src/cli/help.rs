@@ -75,7 +75,7 @@ pub fn build() -> String {
 pub fn trace() -> String {
     format!(
         "Without --areas, one BVH over the scene answers every ray (--builder, or --preset sah or\n\
-         standard). With --areas, rays are answered through the scene structure: an octree (or a\n\
+         standard), traversed as its 4-wide collapse (same answers, faster). With --areas, rays are answered through the scene structure: an octree (or a\n\
          list) finds the areas that may contain a ray's origin; a ray affine to one (origin inside,\n\
          direction within 1 degree of the area's) searches that area's local BVH (built with\n\
          --preset, default full) up to where it leaves the area, and otherwise the fallback BVH\n\

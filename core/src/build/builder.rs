@@ -1,7 +1,7 @@
 //! The build skeleton: choose axes, bin, sweep, then stop or split. Heuristics are type parameters.
 
-use super::arena::{Bin, BuildArena, PrimRefs, Sweep, Task};
-use super::config::{BinSpace, BuildConfig, CutEvaluation};
+use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRef, PrimRefs, Sweep, Task};
+use super::config::{BinSpace, BuildConfig, CutEvaluation, MAX_BINS};
 use super::profile::{Clock, NoClock, PhaseProfile};
 use crate::bvh::{Bvh, BvhNode};
 use alloc::vec::Vec;
@@ -147,6 +147,55 @@ impl BinMap {
     fn bin(&self, c: f32) -> usize {
         // `as usize` saturates (NaN to 0), and the clamp keeps rounding inside the bins.
         ((c - self.min) * self.scale).clamp(0.0, self.last) as usize
+    }
+
+    /// The smallest coordinate `t` with `self.bin(t) >= bin`, for `1 <= bin <= last`: then
+    /// `self.bin(c) < bin` exactly when `c < t`, because every step of [`BinMap::bin`] (a
+    /// subtraction, a multiplication by a positive scale, a clamp, a truncation) is monotone in
+    /// `c`. The partition classifies a primitive with one comparison instead of recomputing its
+    /// bin, and still exactly as the bins counted it.
+    fn threshold(&self, bin: usize) -> f32 {
+        // Floats in their total order as integers: `key` is monotone, so is `at_least`.
+        let key = |x: f32| {
+            let b = x.to_bits() as i32;
+            i64::from(b ^ (((b >> 31) as u32) >> 1) as i32)
+        };
+        let from_key = |k: i64| {
+            let k = k as i32;
+            f32::from_bits((k ^ (((k >> 31) as u32) >> 1) as i32) as u32)
+        };
+        let at_least = |k: i64| self.bin(from_key(k)) >= bin;
+        // bin(-inf) = 0 < bin <= last = bin(+inf): the boundary lies between.
+        let (floor, ceil) = (key(f32::NEG_INFINITY), key(f32::INFINITY));
+        // Start at the plane's position and gallop to a bracket: the estimate is off by the
+        // rounding of `min + bin / scale`, which cancellation can make many ulps of the result.
+        let k0 = key(self.min + bin as f32 / self.scale).clamp(floor, ceil);
+        let (mut lo, mut hi) = if at_least(k0) {
+            (k0 - 1, k0)
+        } else {
+            (k0, k0 + 1)
+        };
+        let mut step = 1;
+        while lo > floor && at_least(lo) {
+            hi = lo;
+            lo = (lo - step).max(floor);
+            step *= 2;
+        }
+        while hi < ceil && !at_least(hi) {
+            lo = hi;
+            hi = (hi + step).min(ceil);
+            step *= 2;
+        }
+        // Invariant: !at_least(lo) (or lo = floor), at_least(hi).
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if at_least(mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        from_key(hi)
     }
 }
 
@@ -521,18 +570,36 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         };
         let (min, scale, last) = (lane(|m| m.min), lane(|m| m.scale), lane(|m| m.last));
         let active = [maps[0].is_some(), maps[1].is_some(), maps[2].is_some()];
-        let refs = &arena.refs;
-        for i in task.start as usize..(task.start + task.count) as usize {
-            let r = refs.get(i);
+        let slots = arena.refs.slots(task.start as usize, task.count as usize);
+        let [bx, by, bz] = &mut arena.bins;
+        let index = |r: &PrimRef| {
             let (lo, hi) = (r.lo4(), r.hi4());
-            let index = ((lo + hi - min) * scale)
+            // Indices are at most `last` (< MAX_BINS), so the mask changes nothing and lets
+            // the compiler drop the bounds checks.
+            let i = ((lo + hi - min) * scale)
                 .fast_max(f32x4::ZERO)
                 .fast_min(last)
                 .fast_trunc_int()
-                .to_array();
-            for axis in 0..3 {
-                if active[axis] {
-                    arena.bins[axis][index[axis] as usize].grow(lo, hi);
+                .to_array()
+                .map(|i| i as usize & (MAX_BINS as usize - 1));
+            (lo, hi, i)
+        };
+        if active == [true; 3] {
+            // The common case (every axis has extent): no per-primitive branch.
+            for r in slots {
+                let (lo, hi, i) = index(r);
+                bx[i[0]].grow(lo, hi);
+                by[i[1]].grow(lo, hi);
+                bz[i[2]].grow(lo, hi);
+            }
+        } else {
+            let bins = [bx, by, bz];
+            for r in slots {
+                let (lo, hi, i) = index(r);
+                for axis in 0..3 {
+                    if active[axis] {
+                        bins[axis][i[axis]].grow(lo, hi);
+                    }
                 }
             }
         }
@@ -585,15 +652,18 @@ fn sweep_axis<M: CostModel>(
         index += f32x4::splat(4.0);
     }
     let (w, i) = (best_w.to_array(), best_i.to_array());
-    let mut best: Option<(f32, usize)> = None;
+    // `<` against +inf also drops NaN and infinite prices. The boundary stays a float until the
+    // winner is known: a saturating float-to-integer conversion per lane costs more than the rest.
+    let (mut weighted, mut at) = (f32::INFINITY, f32::INFINITY);
     for lane in 0..4 {
-        let better =
-            best.is_none_or(|(bw, bi)| w[lane] < bw || (w[lane] == bw && (i[lane] as usize) < bi));
-        if w[lane].is_finite() && better {
-            best = Some((w[lane], i[lane] as usize));
+        if w[lane] < weighted || (w[lane] == weighted && i[lane] < at) {
+            (weighted, at) = (w[lane], i[lane]);
         }
     }
-    let (weighted, bin) = best?;
+    if !weighted.is_finite() {
+        return None;
+    }
+    let bin = at as usize;
     Some(Split {
         axis,
         map,
@@ -617,8 +687,8 @@ fn ceil_log2(n: u32) -> u32 {
 fn partition(arena: &mut BuildArena, task: &Task, split: &Split) -> (Child, Child) {
     let refs = &mut arena.refs;
     let axis = split.axis;
-    let goes_left =
-        |refs: &PrimRefs, i: usize| split.map.bin(refs.centroid2_axis(i, axis)) < split.bin;
+    let threshold = split.map.threshold(split.bin);
+    let goes_left = |refs: &PrimRefs, i: usize| refs.centroid2_axis(i, axis) < threshold;
     // Hoare's scheme: only misplaced pairs are swapped. The child centroid bounds are gathered in
     // 4-wide lanes as each slot settles on its side (lane 3 carries id bits and is dropped).
     let inf = f32x4::splat(f32::INFINITY);
@@ -654,16 +724,6 @@ fn partition(arena: &mut BuildArena, task: &Task, split: &Split) -> (Child, Chil
     (
         (split.left, split.n_left, lanes_to_aabb(l_lo, l_hi)),
         (split.right, split.n_right, lanes_to_aabb(r_lo, r_hi)),
-    )
-}
-
-/// An [`Aabb`] from `(x, y, z, _)` lanes.
-#[inline(always)]
-fn lanes_to_aabb(lo: f32x4, hi: f32x4) -> Aabb {
-    let (lo, hi) = (lo.to_array(), hi.to_array());
-    Aabb::new(
-        glam::Vec3::new(lo[0], lo[1], lo[2]),
-        glam::Vec3::new(hi[0], hi[1], hi[2]),
     )
 }
 

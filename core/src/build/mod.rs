@@ -12,7 +12,7 @@ mod graft;
 mod preset;
 mod profile;
 
-pub use arena::BuildArena;
+pub use arena::{BuildArena, LoadedBounds, TriangleLoad};
 pub use builder::{BuildStats, Builder, Subtree};
 pub use config::{BinSpace, BuildConfig, CutEvaluation, ThesisCut, MAX_BINS};
 pub use graft::GraftError;

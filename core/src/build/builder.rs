@@ -1,6 +1,7 @@
 //! The build skeleton: choose axes, bin, sweep, then stop or split. Heuristics are type parameters.
 
-use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRef, PrimRefs, Sweep, Task};
+use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRefs, Sweep, Task};
+use super::binning::{BinJob, NodeBinner, SerialBinner};
 use super::config::{BinSpace, BuildConfig, CutEvaluation, MAX_BINS};
 use super::profile::{Clock, NoClock, PhaseProfile};
 use crate::bvh::{Bvh, BvhNode};
@@ -12,6 +13,7 @@ use crate::geometry::{Aabb, Triangle};
 use crate::heuristics::{
     AllAxes, AxisChooser, CostModel, LongestAxis, Sah, SahTermination, Termination,
 };
+use crate::simd::Aabb4;
 use crate::BuildError;
 
 /// A subtree left for a separate build by [`Builder::build_top`]: the placeholder leaf `node`
@@ -242,7 +244,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         arena: &mut BuildArena,
         out: &mut Bvh,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, 0, 0, None, &NoClock)
+        self.build_range(arena, out, 0, 0, None, &NoClock, &SerialBinner)
     }
 
     /// [`Builder::build_into`], timing its phases with `clock` into [`BuildStats::profile`].
@@ -252,7 +254,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         out: &mut Bvh,
         clock: &impl Clock,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, 0, 0, None, clock)
+        self.build_range(arena, out, 0, 0, None, clock, &SerialBinner)
     }
 
     /// [`Builder::build_into`] for a subtree whose root sits at depth `depth` of a larger tree, so
@@ -264,7 +266,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         out: &mut Bvh,
         depth: u32,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, depth, 0, None, &NoClock)
+        self.build_range(arena, out, depth, 0, None, &NoClock, &SerialBinner)
     }
 
     /// The top of a build, for threaded builders: like [`Builder::build_into`], but a node of at
@@ -279,10 +281,24 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         cutoff: u32,
         jobs: &mut Vec<Subtree>,
     ) -> Result<BuildStats, BuildError> {
-        jobs.clear();
-        self.build_range(arena, out, 0, cutoff, Some(jobs), &NoClock)
+        self.build_top_with(arena, out, cutoff, jobs, &SerialBinner)
     }
 
+    /// [`Builder::build_top`] with the binning passes offered to `binner` first: a threaded host
+    /// bins the large top nodes on several threads. The result does not depend on the binner.
+    pub fn build_top_with(
+        &self,
+        arena: &mut BuildArena,
+        out: &mut Bvh,
+        cutoff: u32,
+        jobs: &mut Vec<Subtree>,
+        binner: &impl NodeBinner,
+    ) -> Result<BuildStats, BuildError> {
+        jobs.clear();
+        self.build_range(arena, out, 0, cutoff, Some(jobs), &NoClock, binner)
+    }
+
+    #[allow(clippy::too_many_arguments)]
     fn build_range(
         &self,
         arena: &mut BuildArena,
@@ -291,6 +307,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         cutoff: u32,
         mut jobs: Option<&mut Vec<Subtree>>,
         clock: &impl Clock,
+        binner: &impl NodeBinner,
     ) -> Result<BuildStats, BuildError> {
         self.config.validate()?;
         let n = arena.len();
@@ -331,7 +348,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             let decided = if deferred {
                 None
             } else {
-                self.split(arena, &task, &task.bounds, &mut stats, clock)
+                self.split(arena, &task, &task.bounds, &mut stats, clock, binner)
             };
             match decided {
                 None => stats.leaves += u32::from(!deferred),
@@ -382,6 +399,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         bounds: &Aabb,
         stats: &mut BuildStats,
         clock: &impl Clock,
+        binner: &impl NodeBinner,
     ) -> Option<(Child, Child)> {
         let count = task.count;
         if task.depth >= self.config.max_depth || count <= 1 {
@@ -405,6 +423,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                 bounds,
                 &mut stats.profile,
                 clock,
+                binner,
             )
             .map(|s| (s, s.weighted_under(&self.cost) / parent))
         } else {
@@ -412,7 +431,18 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             // uniform-ray model, still orders its subtree sensibly for every other ray.
             let parent = Sah.measure(bounds);
             (parent > 0.0 && parent.is_finite())
-                .then(|| self.choose(&Sah, parent, arena, task, bounds, &mut stats.profile, clock))
+                .then(|| {
+                    self.choose(
+                        &Sah,
+                        parent,
+                        arena,
+                        task,
+                        bounds,
+                        &mut stats.profile,
+                        clock,
+                        binner,
+                    )
+                })
                 .flatten()
                 .map(|s| (s, s.weighted / parent))
         };
@@ -458,6 +488,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         bounds: &Aabb,
         profile: &mut PhaseProfile,
         clock: &impl Clock,
+        binner: &impl NodeBinner,
     ) -> Option<Split> {
         let t0 = clock.now_ns();
         let order = self.axes.order(bounds);
@@ -472,8 +503,20 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             CutEvaluation::Thesis(_) => binned = [true; 3],
         }
         let nb = self.bins_for(task.count);
-        let maps = self.bin(arena, task, bounds, binned, nb);
-        let nb = nb as usize;
+        if task.count == 2
+            && self.config.bin_space == BinSpace::Centroids
+            && !matches!(self.config.cut, CutEvaluation::Thesis(_))
+        {
+            let t0 = clock.now_ns();
+            let axes = order.iter().map(|(a, _)| a).filter(|&a| binned[a]);
+            let split = split_pair(model, arena, task, axes, nb);
+            profile.cost_ns += clock.now_ns() - t0;
+            profile.cost_calls += 1;
+            return split;
+        }
+        let maps = self.bin(arena, task, bounds, binned, nb, binner);
+        // The bins past `nb` up to a multiple of four are empty (see `bin`).
+        let nb = (nb as usize).next_multiple_of(4);
         let BuildArena { bins, sweep, .. } = arena;
         let mut sweep_axis = |axis: usize, model: &M| {
             let t0 = clock.now_ns();
@@ -537,6 +580,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         bounds: &Aabb,
         axes: [bool; 3],
         nb: u32,
+        binner: &impl NodeBinner,
     ) -> [Option<BinMap>; 3] {
         let maps: [Option<BinMap>; 3] = core::array::from_fn(|axis| {
             if !axes[axis] {
@@ -554,7 +598,9 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         });
         for (bins, map) in arena.bins.iter_mut().zip(&maps) {
             if map.is_some() {
-                bins[..nb as usize].fill(Bin::EMPTY);
+                // Up to a multiple of four: empty bins past the last add boundaries with an
+                // empty side, which never win, and let the sweep run with a constant length.
+                bins[..(nb as usize).next_multiple_of(4)].fill(Bin::EMPTY);
             }
         }
         // All three axes' bin indices in one 4-wide evaluation; an axis that is not binned gets
@@ -571,31 +617,28 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         let (min, scale, last) = (lane(|m| m.min), lane(|m| m.scale), lane(|m| m.last));
         let active = [maps[0].is_some(), maps[1].is_some(), maps[2].is_some()];
         let slots = arena.refs.slots(task.start as usize, task.count as usize);
-        let [bx, by, bz] = &mut arena.bins;
-        let index = |r: &PrimRef| {
-            let (lo, hi) = (r.lo4(), r.hi4());
-            // Indices are at most `last` (< MAX_BINS), so the mask changes nothing and lets
-            // the compiler drop the bounds checks.
-            let i = ((lo + hi - min) * scale)
-                .fast_max(f32x4::ZERO)
-                .fast_min(last)
-                .fast_trunc_int()
-                .to_array()
-                .map(|i| i as usize & (MAX_BINS as usize - 1));
-            (lo, hi, i)
+        let job = BinJob {
+            refs: slots,
+            min,
+            scale,
+            last,
         };
-        if active == [true; 3] {
+        if let Some(parts) = binner.bin(&job) {
+            arena.bins = parts.bins;
+        } else if active == [true; 3] {
             // The common case (every axis has extent): no per-primitive branch.
-            for r in slots {
-                let (lo, hi, i) = index(r);
-                bx[i[0]].grow(lo, hi);
-                by[i[1]].grow(lo, hi);
-                bz[i[2]].grow(lo, hi);
-            }
+            job.bin_into(slots, &mut arena.bins);
         } else {
+            let [bx, by, bz] = &mut arena.bins;
             let bins = [bx, by, bz];
             for r in slots {
-                let (lo, hi, i) = index(r);
+                let (lo, hi) = (r.lo4(), r.hi4());
+                let i = ((lo + hi - min) * scale)
+                    .fast_max(f32x4::ZERO)
+                    .fast_min(last)
+                    .fast_trunc_int()
+                    .to_array()
+                    .map(|i| i as usize & (MAX_BINS as usize - 1));
                 for axis in 0..3 {
                     if active[axis] {
                         bins[axis][i[axis]].grow(lo, hi);
@@ -610,7 +653,38 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
 /// The cheapest boundary of one binned axis under `model`. A suffix and a prefix pass write the
 /// boxes and counts on both sides of every boundary into SoA scratch lanes; the boundaries are
 /// then priced four at a time with [`CostModel::measure4`]. O(bins), no allocation.
+///
+/// The usual bin counts get a copy each with the count a constant, so the passes unroll without
+/// bounds checks; most nodes are small, and there this loop overhead was most of the sweep.
 fn sweep_axis<M: CostModel>(
+    bins: &[Bin],
+    sweep: &mut Sweep,
+    axis: usize,
+    map: BinMap,
+    model: &M,
+) -> Option<Split> {
+    match bins.len() {
+        4 => sweep_bins::<M, 4>(bins[..4].try_into().ok()?, sweep, axis, map, model),
+        8 => sweep_bins::<M, 8>(bins[..8].try_into().ok()?, sweep, axis, map, model),
+        12 => sweep_bins::<M, 12>(bins[..12].try_into().ok()?, sweep, axis, map, model),
+        16 => sweep_bins::<M, 16>(bins[..16].try_into().ok()?, sweep, axis, map, model),
+        _ => sweep_any(bins, sweep, axis, map, model),
+    }
+}
+
+#[inline(always)]
+fn sweep_bins<M: CostModel, const NB: usize>(
+    bins: &[Bin; NB],
+    sweep: &mut Sweep,
+    axis: usize,
+    map: BinMap,
+    model: &M,
+) -> Option<Split> {
+    sweep_any(bins, sweep, axis, map, model)
+}
+
+#[inline(always)]
+fn sweep_any<M: CostModel>(
     bins: &[Bin],
     sweep: &mut Sweep,
     axis: usize,
@@ -629,9 +703,10 @@ fn sweep_axis<M: CostModel>(
         acc.merge(&bins[i - 1]);
         sweep.left.set(i, &acc);
     }
-    for i in nb..nb + 3 {
-        sweep.left.set(i, &Bin::EMPTY);
-        sweep.right.set(i, &Bin::EMPTY);
+    // Lanes past the last boundary, up to the end of its group of four: no primitive on the
+    // right prices them as +inf.
+    for i in nb..=(nb - 1).div_ceil(4) * 4 {
+        sweep.right.count[i] = 0;
     }
     // The cheapest boundary per lane, then across lanes. Boundaries with an empty side, and the
     // padding lanes past the last boundary (count 0), price as +inf. Strict `<` keeps the first
@@ -676,6 +751,55 @@ fn sweep_axis<M: CostModel>(
     })
 }
 
+/// The split of a two-primitive node, without binning or sweeping, and the very split they would
+/// choose: along an axis where the two centroids differ they fall in the first and the last
+/// centroid bin, so every boundary between splits them alike at the same price, and the sweep
+/// keeps the lowest boundary, 1. Among the `axes` in the order they would be swept, the first
+/// that separates the centroids wins (a later axis prices the same split no lower). Half the
+/// nodes a SAH build prices hold two primitives. The price comes from [`CostModel::measure4`],
+/// like the sweep's, so it is bit for bit the sweep's.
+fn split_pair<M: CostModel>(
+    model: &M,
+    arena: &BuildArena,
+    task: &Task,
+    mut axes: impl Iterator<Item = usize>,
+    nb: u32,
+) -> Option<Split> {
+    let (axis, map) = axes.find_map(|axis| {
+        let (lo, hi) = (task.centroids.min[axis], task.centroids.max[axis]);
+        (hi > lo)
+            .then(|| BinMap::new(lo, hi, nb))
+            .flatten()
+            .map(|m| (axis, m))
+    })?;
+    let s = task.start as usize;
+    let (mut left, mut right) = (s, s + 1);
+    if arena.refs.centroid2_axis(s, axis) > arena.refs.centroid2_axis(s + 1, axis) {
+        (left, right) = (right, left);
+    }
+    let (left, right) = (arena.refs.bounds(left), arena.refs.bounds(right));
+    let lanes = |f: fn(&Aabb) -> glam::Vec3| {
+        let (l, r) = (f(&left), f(&right));
+        core::array::from_fn(|k| f32x4::from([l[k], r[k], r[k], r[k]]))
+    };
+    let m = model
+        .measure4(&Aabb4 {
+            min: lanes(|b| b.min),
+            max: lanes(|b| b.max),
+        })
+        .to_array();
+    Some(Split {
+        axis,
+        map,
+        bin: 1,
+        left,
+        right,
+        n_left: 1,
+        n_right: 1,
+        weighted: m[0] * 1.0 + m[1] * 1.0,
+    })
+}
+
 /// `ceil(log2(n))` for `n >= 1`.
 #[inline]
 fn ceil_log2(n: u32) -> u32 {
@@ -685,10 +809,29 @@ fn ceil_log2(n: u32) -> u32 {
 /// Partitions the node's slots in place by the split's bin boundary. The child boxes come from
 /// the bins; the children's centroid bounds are gathered as each slot is classified.
 fn partition(arena: &mut BuildArena, task: &Task, split: &Split) -> (Child, Child) {
+    // Finding the threshold costs a few dozen bin evaluations: small nodes classify by bin.
+    if task.count <= THRESHOLD_MIN_COUNT {
+        partition_by(arena, task, split, |c| split.map.bin(c) < split.bin)
+    } else {
+        let threshold = split.map.threshold(split.bin);
+        partition_by(arena, task, split, |c| c < threshold)
+    }
+}
+
+/// Nodes above this size partition by [`BinMap::threshold`].
+const THRESHOLD_MIN_COUNT: u32 = 16;
+
+/// [`partition`] with the classification `goes_left` of a doubled centroid coordinate.
+#[inline(always)]
+fn partition_by(
+    arena: &mut BuildArena,
+    task: &Task,
+    split: &Split,
+    goes_left: impl Fn(f32) -> bool,
+) -> (Child, Child) {
     let refs = &mut arena.refs;
     let axis = split.axis;
-    let threshold = split.map.threshold(split.bin);
-    let goes_left = |refs: &PrimRefs, i: usize| refs.centroid2_axis(i, axis) < threshold;
+    let goes_left = |refs: &PrimRefs, i: usize| goes_left(refs.centroid2_axis(i, axis));
     // Hoare's scheme: only misplaced pairs are swapped. The child centroid bounds are gathered in
     // 4-wide lanes as each slot settles on its side (lane 3 carries id bits and is dropped).
     let inf = f32x4::splat(f32::INFINITY);
@@ -916,6 +1059,29 @@ mod tests {
             bad.build(&soup(3, 1)),
             Err(BuildError::InvalidConfig(_))
         ));
+    }
+
+    #[test]
+    fn threshold_classifies_like_the_bins() {
+        let mut rng = crate::random::Pcg32::new(5);
+        for round in 0..2000 {
+            // Offsets far from the origin make `min + bin / scale` cancel badly.
+            let offset = [0.0, 1e3, -1e5, 3e7][round % 4];
+            let lo = offset + rng.range(-10.0, 10.0);
+            let hi = lo + rng.range(1e-4, 20.0);
+            let nb = 2 + (round as u32 % 15);
+            let Some(map) = BinMap::new(lo, hi, nb) else {
+                continue;
+            };
+            for bin in 1..nb as usize {
+                let t = map.threshold(bin);
+                assert!(map.bin(t) >= bin && map.bin(t.next_down()) < bin);
+                for _ in 0..20 {
+                    let c = lo + rng.range(0.0, 1.0) * (hi - lo);
+                    assert_eq!(c < t, map.bin(c) < bin, "{map:?} bin {bin} c {c} t {t}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -6,6 +6,7 @@
 //! front, and the output [`crate::bvh::Bvh`] can be pre-sized too, so a build allocates nothing.
 
 mod arena;
+mod binning;
 mod builder;
 mod config;
 mod graft;
@@ -13,6 +14,7 @@ mod preset;
 mod profile;
 
 pub use arena::{BuildArena, LoadedBounds, TriangleLoad};
+pub use binning::{BinJob, NodeBinner, NodeBins, SerialBinner};
 pub use builder::{BuildStats, Builder, Subtree};
 pub use config::{BinSpace, BuildConfig, CutEvaluation, ThesisCut, MAX_BINS};
 pub use graft::GraftError;

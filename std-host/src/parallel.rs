@@ -128,11 +128,7 @@ where
     T: Termination,
 {
     let mut local = BuildArena::with_capacity(job.count as usize);
-    for slot in job.start..job.start + job.count {
-        if let Some((id, bounds)) = arena.prim(slot as usize) {
-            local.push(id, bounds)?;
-        }
-    }
+    local.load_slots(arena, job.start as usize..(job.start + job.count) as usize)?;
     let mut out = Bvh::with_capacity(job.count as usize);
     builder.build_subtree_into(&mut local, &mut out, job.depth)?;
     Ok(out)

@@ -1,6 +1,7 @@
 //! The build arena: every buffer a build needs, allocated once and reused.
 
 use alloc::vec::Vec;
+use core::ops::Range;
 
 use glam::Vec3;
 use wide::f32x4;
@@ -312,6 +313,42 @@ impl BuildArena {
         self.refs.refs.push(PrimRef::new(id, &bounds));
         self.bounds = self.bounds.union(bounds);
         self.centroids = self.centroids.grown(bounds.min + bounds.max);
+        Ok(())
+    }
+
+    /// Clears the arena and loads the primitives in `other`'s slots `slots` (ids and bounds, in
+    /// slot order): a threaded build's subtree job copies its primitives this way, one block
+    /// copy and one 4-wide bounds pass instead of a checked push per primitive. Fails when they
+    /// do not fit or `slots` lies outside `other`'s primitives.
+    pub fn load_slots(
+        &mut self,
+        other: &BuildArena,
+        slots: Range<usize>,
+    ) -> Result<(), BuildError> {
+        self.clear();
+        let refs = other
+            .refs
+            .refs
+            .get(slots)
+            .ok_or(BuildError::InvalidConfig("slots outside the source arena"))?;
+        if refs.len() > self.capacity {
+            return Err(BuildError::ArenaFull {
+                capacity: self.capacity,
+            });
+        }
+        self.refs.refs.extend_from_slice(refs);
+        let mut acc = LoadedBounds::EMPTY;
+        // The source validated these bounds. Lane 3 (id bits, zero) is dropped by lanes_to_aabb.
+        for r in refs {
+            let (lo, hi) = (r.lo4(), r.hi4());
+            let centroid = lo + hi;
+            acc.min = acc.min.fast_min(lo);
+            acc.max = acc.max.fast_max(hi);
+            acc.centroid_min = acc.centroid_min.fast_min(centroid);
+            acc.centroid_max = acc.centroid_max.fast_max(centroid);
+        }
+        self.bounds = lanes_to_aabb(acc.min, acc.max);
+        self.centroids = lanes_to_aabb(acc.centroid_min, acc.centroid_max);
         Ok(())
     }
 

@@ -2,7 +2,8 @@
 //! before/after checks of the builder. Prints the best thread CPU time of `REPS` builds (default
 //! 7), the tree's SAH cost, its node count and a hash of its nodes and leaf order (two builds with
 //! the same hash made the same tree), then the threaded build's best wall time on the global pool
-//! and on one thread and whether its tree equals the single-threaded one.
+//! and on one thread, the single-threaded build's best wall time (the `peers` scaling is that
+//! over the threaded build's) and whether the threaded tree equals the single-threaded one.
 //!
 //! Under `valgrind --tool=callgrind --toggle-collect=build_profile::build_once`, only the builds
 //! (loading the triangle bounds included) are counted; `RDBVH_PROFILE_MT=0` skips the threaded
@@ -107,13 +108,17 @@ fn main() -> ExitCode {
     let same = mt == bvh;
     let wall_mt = best_wall(reps, || build_mt_once(&tris));
     let wall_1 = one.install(|| best_wall(reps, || build_mt_once(&tris)));
+    let wall_serial = best_wall(reps, || build_once(&tris));
     println!(
-        "  parallel::build: {} threads {:.2} ms, 1 thread {:.2} ms, scaling {:.2}x; \
-         same tree as 1t: {same}; load {:?}",
+        "  parallel::build: {} threads {:.2} ms, 1 thread {:.2} ms ({:.2}x); single-threaded \
+         build {:.2} ms wall, scaling {:.2}x (as peers: 1t build / threaded); same tree as 1t: \
+         {same}; load {:?}",
         rayon::current_num_threads(),
         wall_mt * 1e3,
         wall_1 * 1e3,
         wall_1 / wall_mt,
+        wall_serial * 1e3,
+        wall_serial / wall_mt,
         std::fs::read_to_string("/proc/loadavg")
             .unwrap_or_default()
             .trim()

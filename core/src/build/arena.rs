@@ -245,6 +245,8 @@ pub(crate) struct Task {
 pub struct BuildArena {
     pub(crate) refs: PrimRefs,
     pub(crate) bins: [[Bin; MAX_BINS as usize]; 3],
+    /// A second set of bins, for large nodes binned in two interleaved halves.
+    pub(crate) bins2: [[Bin; MAX_BINS as usize]; 3],
     pub(crate) sweep: Sweep,
     pub(crate) tasks: Vec<Task>,
     pub(crate) bounds: Aabb,
@@ -258,6 +260,7 @@ impl BuildArena {
         Self {
             refs: PrimRefs::with_capacity(capacity),
             bins: [[Bin::EMPTY; MAX_BINS as usize]; 3],
+            bins2: [[Bin::EMPTY; MAX_BINS as usize]; 3],
             sweep: Sweep {
                 left: SweepSide::new(),
                 right: SweepSide::new(),

@@ -52,11 +52,30 @@ impl BinJob<'_> {
 
     /// Bins the node's slots `range` (counted from the node's first slot) into fresh bins.
     pub fn bin_range(&self, range: Range<usize>) -> NodeBins {
-        let mut out = NodeBins {
+        let empty = || NodeBins {
             bins: [[Bin::EMPTY; MAX_BINS as usize]; 3],
         };
-        self.bin_into(&self.refs[range], &mut out.bins);
+        let (mut out, mut odd) = (empty(), empty());
+        self.bin_into_dual(&self.refs[range], &mut out.bins, &mut odd.bins);
+        out.merge(&odd);
         out
+    }
+
+    /// [`BinJob::bin_into`] with even slots into `even` and odd ones into `odd`: two independent
+    /// chains of bin updates instead of one.
+    #[inline(always)]
+    pub(crate) fn bin_into_dual(
+        &self,
+        refs: &[PrimRef],
+        even: &mut [[Bin; MAX_BINS as usize]; 3],
+        odd: &mut [[Bin; MAX_BINS as usize]; 3],
+    ) {
+        let mut pairs = refs.chunks_exact(2);
+        for pair in &mut pairs {
+            self.bin_into(&pair[..1], even);
+            self.bin_into(&pair[1..], odd);
+        }
+        self.bin_into(pairs.remainder(), even);
     }
 
     /// Grows `bins` by `refs` along all three axes. An axis that is not binned has scale 0, so

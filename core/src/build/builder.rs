@@ -627,7 +627,20 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             arena.bins = parts.bins;
         } else if active == [true; 3] {
             // The common case (every axis has extent): no per-primitive branch.
-            job.bin_into(slots, &mut arena.bins);
+            if slots.len() >= DUAL_BINNING_MIN {
+                let nbp = (nb as usize).next_multiple_of(4);
+                for bins in &mut arena.bins2 {
+                    bins[..nbp].fill(Bin::EMPTY);
+                }
+                job.bin_into_dual(slots, &mut arena.bins, &mut arena.bins2);
+                for (mine, theirs) in arena.bins.iter_mut().zip(&arena.bins2) {
+                    for (a, b) in mine[..nbp].iter_mut().zip(&theirs[..nbp]) {
+                        a.merge(b);
+                    }
+                }
+            } else {
+                job.bin_into(slots, &mut arena.bins);
+            }
         } else {
             let [bx, by, bz] = &mut arena.bins;
             let bins = [bx, by, bz];
@@ -817,6 +830,11 @@ fn partition(arena: &mut BuildArena, task: &Task, split: &Split) -> (Child, Chil
         partition_by(arena, task, split, |c| c < threshold)
     }
 }
+
+/// Nodes of at least this size are binned into two sets of bins, even and odd slots apart, then
+/// merged: neighbouring primitives of a mesh often fall in the same bins, and growing one bin
+/// twice in a row waits on the store of the first growth.
+const DUAL_BINNING_MIN: usize = 256;
 
 /// Nodes above this size partition by [`BinMap::threshold`].
 const THRESHOLD_MIN_COUNT: u32 = 16;

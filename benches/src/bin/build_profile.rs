@@ -5,6 +5,9 @@
 //! and on one thread, the single-threaded build's best wall time (the `peers` scaling is that
 //! over the threaded build's) and whether the threaded tree equals the single-threaded one.
 //!
+//! `RDBVH_PROFILE_PAH=1` adds the `full` preset (PAH + SPFH) over the `peers` table's plane and
+//! point areas: CPU time, its ratio to the SAH build's, and the tree's hash.
+//!
 //! Under `valgrind --tool=callgrind --toggle-collect=build_profile::build_once`, only the builds
 //! (loading the triangle bounds included) are counted; `RDBVH_PROFILE_MT=0` skips the threaded
 //! part, so callgrind runs stay short.
@@ -14,11 +17,13 @@ use std::hint::black_box;
 use std::process::ExitCode;
 use std::time::Instant;
 
+use rdbvh_benches::compare::{plane_area_over, point_area_over};
 use rdbvh_benches::{load_scene, thread_cpu_seconds};
-use rdbvh_core::build::Builder;
+use rdbvh_core::build::{BuildArena, Builder, Preset, PresetOptions};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::heuristics::{CostConstants, Sah};
+use rdbvh_core::influence::InfluenceArea;
 
 /// One timed build: loading the bounds and the binned SAH build, as the `peers` table times it.
 #[inline(never)]
@@ -97,6 +102,35 @@ fn main() -> ExitCode {
         n as f64 / best * 1e-6,
         bvh.nodes().len()
     );
+    // PAH: the `full` preset (PAH + SPFH) with the plane and point areas the `peers` table uses.
+    if std::env::var("RDBVH_PROFILE_PAH").is_ok_and(|v| v == "1") {
+        let b = tris.iter().fold(rdbvh_core::geometry::Aabb::EMPTY, |b, t| {
+            b.union(t.bounds())
+        });
+        let areas: [(&str, InfluenceArea); 2] = [
+            ("plane", plane_area_over(&b).expect("plane").into()),
+            ("point", point_area_over(&b).expect("point").into()),
+        ];
+        for (name, area) in &areas {
+            let mut arena = BuildArena::with_capacity(n);
+            let mut out = Bvh::with_capacity(n);
+            let mut best_pah = f64::INFINITY;
+            for _ in 0..reps {
+                let t = thread_cpu_seconds();
+                arena.load_triangles(&tris).expect("finite");
+                Preset::Full
+                    .build_into(Some(area), &PresetOptions::default(), &mut arena, &mut out)
+                    .expect("pah build");
+                best_pah = best_pah.min(thread_cpu_seconds() - t);
+            }
+            println!(
+                "  full {name} area: {:.2} ms ({:.2}x the SAH build); tree {:016x}",
+                best_pah * 1e3,
+                best_pah / best,
+                tree_hash(&out)
+            );
+        }
+    }
     if std::env::var("RDBVH_PROFILE_MT").is_ok_and(|v| v == "0") {
         return ExitCode::SUCCESS;
     }

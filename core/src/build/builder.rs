@@ -503,13 +503,33 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             CutEvaluation::Thesis(_) => binned = [true; 3],
         }
         let nb = self.bins_for(task.count);
-        if task.count == 2
-            && self.config.bin_space == BinSpace::Centroids
-            && !matches!(self.config.cut, CutEvaluation::Thesis(_))
-        {
+        if task.count == 2 && self.config.bin_space == BinSpace::Centroids {
             let t0 = clock.now_ns();
-            let axes = order.iter().map(|(a, _)| a).filter(|&a| binned[a]);
-            let split = split_pair(model, arena, task, axes, nb);
+            let mut axes = order.iter().map(|(a, _)| a).filter(|&a| binned[a]);
+            let split = match self.config.cut {
+                CutEvaluation::BestOfAxes => {
+                    axes.find_map(|a| split_pair(model, arena, task, a, nb))
+                }
+                CutEvaluation::FirstAxis => split_pair(model, arena, task, first, nb),
+                // The thesis's walk, with every separating axis pricing the same split: the
+                // first one before the quality cut-off is the best, and no later one replaces it.
+                CutEvaluation::Thesis(cut) => {
+                    let best = order
+                        .iter()
+                        .enumerate()
+                        .take_while(|&(i, (_, quality))| i == 0 || quality >= cut.quality_threshold)
+                        .find_map(|(_, (a, _))| split_pair(model, arena, task, a, nb));
+                    match best {
+                        Some(b)
+                            if b.ratio_under(model, parent) <= cut.excellent_ratio
+                                || b.ratio_under(model, parent) <= cut.acceptable_ratio =>
+                        {
+                            Some(b)
+                        }
+                        _ => split_pair(&Sah, arena, task, bounds.largest_axis(), nb).or(best),
+                    }
+                }
+            };
             profile.cost_ns += clock.now_ns() - t0;
             profile.cost_calls += 1;
             return split;
@@ -768,23 +788,18 @@ fn sweep_any<M: CostModel>(
 /// choose: along an axis where the two centroids differ they fall in the first and the last
 /// centroid bin, so every boundary between splits them alike at the same price, and the sweep
 /// keeps the lowest boundary, 1. Among the `axes` in the order they would be swept, the first
-/// that separates the centroids wins (a later axis prices the same split no lower). Half the
+/// that separates the centroids wins (a later axis prices the same split no lower); `None` when
+/// `axis` does not separate them. Half the
 /// nodes a SAH build prices hold two primitives. The price comes from [`CostModel::measure4`],
 /// like the sweep's, so it is bit for bit the sweep's.
 fn split_pair<M: CostModel>(
     model: &M,
     arena: &BuildArena,
     task: &Task,
-    mut axes: impl Iterator<Item = usize>,
+    axis: usize,
     nb: u32,
 ) -> Option<Split> {
-    let (axis, map) = axes.find_map(|axis| {
-        let (lo, hi) = (task.centroids.min[axis], task.centroids.max[axis]);
-        (hi > lo)
-            .then(|| BinMap::new(lo, hi, nb))
-            .flatten()
-            .map(|m| (axis, m))
-    })?;
+    let map = pair_map(task, axis, nb)?;
     let s = task.start as usize;
     let (mut left, mut right) = (s, s + 1);
     if arena.refs.centroid2_axis(s, axis) > arena.refs.centroid2_axis(s + 1, axis) {
@@ -811,6 +826,13 @@ fn split_pair<M: CostModel>(
         n_right: 1,
         weighted: m[0] * 1.0 + m[1] * 1.0,
     })
+}
+
+/// The bin map of a two-primitive node along `axis`, as [`Builder::bin`] makes it, or `None`
+/// where the centroids coincide.
+fn pair_map(task: &Task, axis: usize, nb: u32) -> Option<BinMap> {
+    let (lo, hi) = (task.centroids.min[axis], task.centroids.max[axis]);
+    (hi > lo).then(|| BinMap::new(lo, hi, nb)).flatten()
 }
 
 /// `ceil(log2(n))` for `n >= 1`.

@@ -106,20 +106,29 @@ struct Split {
     n_right: u32,
     /// `m(L) n_L + m(R) n_R` under the model that chose the split.
     weighted: f32,
+    /// `m(L)` and `m(R)` under the model that chose the split, once [`Split::ratio_under`]
+    /// needed them: a PAH measure costs more than a sweep, and the leaf test needs them again.
+    measured: Option<[f32; 2]>,
 }
 
 impl Split {
-    /// `m(L) n_L + m(R) n_R` under `model`.
+    /// `m(L) n_L + m(R) n_R` under `model`, which must be the model that chose the split.
     #[inline]
     fn weighted_under(&self, model: &impl CostModel) -> f32 {
-        model.measure(&self.left) * self.n_left as f32
-            + model.measure(&self.right) * self.n_right as f32
+        let [l, r] = self
+            .measured
+            .unwrap_or_else(|| [model.measure(&self.left), model.measure(&self.right)]);
+        l * self.n_left as f32 + r * self.n_right as f32
     }
 
-    /// The thesis's cut ratio `(m(L) + m(R)) / m(parent)`.
+    /// The thesis's cut ratio `(m(L) + m(R)) / m(parent)` under the model that chose the split;
+    /// keeps the two measures.
     #[inline]
-    fn ratio_under(&self, model: &impl CostModel, parent: f32) -> f32 {
-        (model.measure(&self.left) + model.measure(&self.right)) / parent
+    fn ratio_under(&mut self, model: &impl CostModel, parent: f32) -> f32 {
+        let [l, r] = *self
+            .measured
+            .get_or_insert_with(|| [model.measure(&self.left), model.measure(&self.right)]);
+        (l + r) / parent
     }
 }
 
@@ -519,10 +528,11 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                         .enumerate()
                         .take_while(|&(i, (_, quality))| i == 0 || quality >= cut.quality_threshold)
                         .find_map(|(_, (a, _))| split_pair(model, arena, task, a, nb));
-                    match best {
-                        Some(b)
-                            if b.ratio_under(model, parent) <= cut.excellent_ratio
-                                || b.ratio_under(model, parent) <= cut.acceptable_ratio =>
+                    let mut best = best;
+                    let ratio = best.as_mut().map(|b| b.ratio_under(model, parent));
+                    match (best, ratio) {
+                        (Some(b), Some(r))
+                            if r <= cut.excellent_ratio || r <= cut.acceptable_ratio =>
                         {
                             Some(b)
                         }
@@ -559,22 +569,28 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             }
             CutEvaluation::FirstAxis => sweep_axis(first, model),
             CutEvaluation::Thesis(cut) => {
-                let mut best: Option<Split> = None;
+                // The best split so far with its cut ratio, computed once per new best: with a
+                // PAH model each ratio is two scalar measures, which cost more than a sweep.
+                let mut best: Option<(Split, f32)> = None;
                 for (i, (axis, quality)) in order.iter().enumerate() {
                     if i > 0 && quality < cut.quality_threshold {
                         break;
                     }
-                    if let Some(s) = sweep_axis(axis, model) {
-                        if best.is_none_or(|b| s.weighted < b.weighted) {
-                            best = Some(s);
+                    if let Some(mut s) = sweep_axis(axis, model) {
+                        if best.is_none_or(|(b, _)| s.weighted < b.weighted) {
+                            let r = s.ratio_under(model, parent);
+                            best = Some((s, r));
                         }
                     }
-                    if best.is_some_and(|b| b.ratio_under(model, parent) <= cut.excellent_ratio) {
-                        return best;
+                    if let Some((b, r)) = best {
+                        if r <= cut.excellent_ratio {
+                            return Some(b);
+                        }
                     }
                 }
-                match best {
-                    Some(b) if b.ratio_under(model, parent) <= cut.acceptable_ratio => Some(b),
+                let (best, ratio) = (best.map(|(b, _)| b), best.map(|(_, r)| r));
+                match (best, ratio) {
+                    (Some(b), Some(r)) if r <= cut.acceptable_ratio => Some(b),
                     // Not even acceptable: SAH on the longest axis, the thesis's fallback.
                     _ => {
                         let axis = bounds.largest_axis();
@@ -781,6 +797,7 @@ fn sweep_any<M: CostModel>(
         n_left: sweep.left.count[bin],
         n_right: sweep.right.count[bin],
         weighted,
+        measured: None,
     })
 }
 
@@ -825,6 +842,7 @@ fn split_pair<M: CostModel>(
         n_left: 1,
         n_right: 1,
         weighted: m[0] * 1.0 + m[1] * 1.0,
+        measured: None,
     })
 }
 

@@ -25,8 +25,11 @@ use rdbvh_core::influence::InfluenceArea;
 use rdbvh_core::toplevel::{AreaLookup, Scene, SceneError, SceneOptions};
 use rdbvh_core::BuildError;
 
-/// Jobs per thread: enough that uneven subtrees still balance across threads.
-const JOBS_PER_THREAD: usize = 16;
+/// Jobs per thread: enough that uneven subtrees still balance across threads, few enough that
+/// the top (whose partitions run on one thread) stays shallow. On 2 threads, 4 beat 16 and 2
+/// (bunny 13.9-15.0 ms against 15.2-16.2 and 14.4-14.8; Sponza 61.0-63.2 against 61.0-70.7 and
+/// 65.1-66.6, wall, best of 11, two rounds, load 1.5-2.1).
+const JOBS_PER_THREAD: usize = 4;
 
 /// The smallest subtree worth a job of its own: below this, scheduling costs more than it saves.
 const MIN_JOB: u32 = 2048;

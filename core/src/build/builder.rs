@@ -1,7 +1,8 @@
 //! The build skeleton: choose axes, bin, sweep, then stop or split. Heuristics are type parameters.
 
-use super::arena::{Bin, BuildArena, PrimRefs, Sweep, Task};
-use super::config::{BinSpace, BuildConfig, CutEvaluation};
+use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRefs, Sweep, Task};
+use super::binning::{BinJob, NodeBinner, SerialBinner};
+use super::config::{BinSpace, BuildConfig, CutEvaluation, MAX_BINS};
 use super::profile::{Clock, NoClock, PhaseProfile};
 use crate::bvh::{Bvh, BvhNode};
 use alloc::vec::Vec;
@@ -127,7 +128,8 @@ impl Split {
         }
     }
 
-    /// The thesis's cut ratio `(m(L) + m(R)) / m(parent)`.
+    /// The thesis's cut ratio `(m(L) + m(R)) / m(parent)` under the model that chose the split;
+    /// keeps the two measures.
     #[inline]
     fn ratio(&self, parent: f32) -> f32 {
         (self.measure_left + self.measure_right) / parent
@@ -160,6 +162,55 @@ impl BinMap {
     fn bin(&self, c: f32) -> usize {
         // `as usize` saturates (NaN to 0), and the clamp keeps rounding inside the bins.
         ((c - self.min) * self.scale).clamp(0.0, self.last) as usize
+    }
+
+    /// The smallest coordinate `t` with `self.bin(t) >= bin`, for `1 <= bin <= last`: then
+    /// `self.bin(c) < bin` exactly when `c < t`, because every step of [`BinMap::bin`] (a
+    /// subtraction, a multiplication by a positive scale, a clamp, a truncation) is monotone in
+    /// `c`. The partition classifies a primitive with one comparison instead of recomputing its
+    /// bin, and still exactly as the bins counted it.
+    fn threshold(&self, bin: usize) -> f32 {
+        // Floats in their total order as integers: `key` is monotone, so is `at_least`.
+        let key = |x: f32| {
+            let b = x.to_bits() as i32;
+            i64::from(b ^ (((b >> 31) as u32) >> 1) as i32)
+        };
+        let from_key = |k: i64| {
+            let k = k as i32;
+            f32::from_bits((k ^ (((k >> 31) as u32) >> 1) as i32) as u32)
+        };
+        let at_least = |k: i64| self.bin(from_key(k)) >= bin;
+        // bin(-inf) = 0 < bin <= last = bin(+inf): the boundary lies between.
+        let (floor, ceil) = (key(f32::NEG_INFINITY), key(f32::INFINITY));
+        // Start at the plane's position and gallop to a bracket: the estimate is off by the
+        // rounding of `min + bin / scale`, which cancellation can make many ulps of the result.
+        let k0 = key(self.min + bin as f32 / self.scale).clamp(floor, ceil);
+        let (mut lo, mut hi) = if at_least(k0) {
+            (k0 - 1, k0)
+        } else {
+            (k0, k0 + 1)
+        };
+        let mut step = 1;
+        while lo > floor && at_least(lo) {
+            hi = lo;
+            lo = (lo - step).max(floor);
+            step *= 2;
+        }
+        while hi < ceil && !at_least(hi) {
+            lo = hi;
+            hi = (hi + step).min(ceil);
+            step *= 2;
+        }
+        // Invariant: !at_least(lo) (or lo = floor), at_least(hi).
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if at_least(mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        from_key(hi)
     }
 }
 
@@ -206,7 +257,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         arena: &mut BuildArena,
         out: &mut Bvh,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, 0, 0, None, &NoClock)
+        self.build_range(arena, out, 0, 0, None, &NoClock, &SerialBinner)
     }
 
     /// [`Builder::build_into`], timing its phases with `clock` into [`BuildStats::profile`].
@@ -216,7 +267,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         out: &mut Bvh,
         clock: &impl Clock,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, 0, 0, None, clock)
+        self.build_range(arena, out, 0, 0, None, clock, &SerialBinner)
     }
 
     /// [`Builder::build_into`] for a subtree whose root sits at depth `depth` of a larger tree, so
@@ -228,7 +279,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         out: &mut Bvh,
         depth: u32,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, depth, 0, None, &NoClock)
+        self.build_range(arena, out, depth, 0, None, &NoClock, &SerialBinner)
     }
 
     /// The top of a build, for threaded builders: like [`Builder::build_into`], but a node of at
@@ -243,10 +294,24 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         cutoff: u32,
         jobs: &mut Vec<Subtree>,
     ) -> Result<BuildStats, BuildError> {
-        jobs.clear();
-        self.build_range(arena, out, 0, cutoff, Some(jobs), &NoClock)
+        self.build_top_with(arena, out, cutoff, jobs, &SerialBinner)
     }
 
+    /// [`Builder::build_top`] with the binning passes offered to `binner` first: a threaded host
+    /// bins the large top nodes on several threads. The result does not depend on the binner.
+    pub fn build_top_with(
+        &self,
+        arena: &mut BuildArena,
+        out: &mut Bvh,
+        cutoff: u32,
+        jobs: &mut Vec<Subtree>,
+        binner: &impl NodeBinner,
+    ) -> Result<BuildStats, BuildError> {
+        jobs.clear();
+        self.build_range(arena, out, 0, cutoff, Some(jobs), &NoClock, binner)
+    }
+
+    #[allow(clippy::too_many_arguments)]
     fn build_range(
         &self,
         arena: &mut BuildArena,
@@ -255,6 +320,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         cutoff: u32,
         mut jobs: Option<&mut Vec<Subtree>>,
         clock: &impl Clock,
+        binner: &impl NodeBinner,
     ) -> Result<BuildStats, BuildError> {
         self.config.validate()?;
         let n = arena.len();
@@ -295,7 +361,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             let decided = if deferred {
                 None
             } else {
-                self.split(arena, &task, &task.bounds, &mut stats, clock)
+                self.split(arena, &task, &task.bounds, &mut stats, clock, binner)
             };
             match decided {
                 None => stats.leaves += u32::from(!deferred),
@@ -346,6 +412,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         bounds: &Aabb,
         stats: &mut BuildStats,
         clock: &impl Clock,
+        binner: &impl NodeBinner,
     ) -> Option<(Child, Child)> {
         let count = task.count;
         if task.depth >= self.config.max_depth || count <= 1 {
@@ -369,6 +436,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                 bounds,
                 &mut stats.profile,
                 clock,
+                binner,
             )
             .map(|s| (s, s.weighted / parent))
         } else {
@@ -376,7 +444,18 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             // uniform-ray model, still orders its subtree sensibly for every other ray.
             let parent = Sah.measure(bounds);
             (parent > 0.0 && parent.is_finite())
-                .then(|| self.choose(&Sah, parent, arena, task, bounds, &mut stats.profile, clock))
+                .then(|| {
+                    self.choose(
+                        &Sah,
+                        parent,
+                        arena,
+                        task,
+                        bounds,
+                        &mut stats.profile,
+                        clock,
+                        binner,
+                    )
+                })
                 .flatten()
                 .map(|s| (s, s.weighted / parent))
         };
@@ -422,6 +501,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         bounds: &Aabb,
         profile: &mut PhaseProfile,
         clock: &impl Clock,
+        binner: &impl NodeBinner,
     ) -> Option<Split> {
         let t0 = clock.now_ns();
         let order = self.axes.order(bounds);
@@ -436,8 +516,38 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             CutEvaluation::Thesis(_) => binned = [true; 3],
         }
         let nb = self.bins_for(task.count);
-        let maps = self.bin(arena, task, bounds, binned, nb);
-        let nb = nb as usize;
+        if task.count == 2 && self.config.bin_space == BinSpace::Centroids {
+            let t0 = clock.now_ns();
+            let mut axes = order.iter().map(|(a, _)| a).filter(|&a| binned[a]);
+            let split = match self.config.cut {
+                CutEvaluation::BestOfAxes => {
+                    axes.find_map(|a| split_pair(model, arena, task, a, nb))
+                }
+                CutEvaluation::FirstAxis => split_pair(model, arena, task, first, nb),
+                // The thesis's walk, with every separating axis pricing the same split: the
+                // first one before the quality cut-off is the best, and no later one replaces it.
+                CutEvaluation::Thesis(cut) => {
+                    let best = order
+                        .iter()
+                        .enumerate()
+                        .take_while(|&(i, (_, quality))| i == 0 || quality >= cut.quality_threshold)
+                        .find_map(|(_, (a, _))| split_pair(model, arena, task, a, nb));
+                    match best {
+                        Some(b) if b.ratio(parent) <= cut.acceptable_ratio => Some(b),
+                        // Found under SAH, priced under `model` like the sweep's fallback.
+                        _ => split_pair(&Sah, arena, task, bounds.largest_axis(), nb)
+                            .map(|s| s.priced_under(model))
+                            .or(best),
+                    }
+                }
+            };
+            profile.cost_ns += clock.now_ns() - t0;
+            profile.cost_calls += 1;
+            return split;
+        }
+        let maps = self.bin(arena, task, bounds, binned, nb, binner);
+        // The bins past `nb` up to a multiple of four are empty (see `bin`).
+        let nb = (nb as usize).next_multiple_of(4);
         let BuildArena { bins, sweep, .. } = arena;
         // Every candidate box lies inside the node: what the model can settle for all of them
         // (say, that they are inside the light's window) it settles once here.
@@ -463,6 +573,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             }
             CutEvaluation::FirstAxis => sweep_axis(first, model),
             CutEvaluation::Thesis(cut) => {
+                // Cut ratios come from the measures each split keeps from its sweep.
                 let mut best: Option<Split> = None;
                 for (i, (axis, quality)) in order.iter().enumerate() {
                     if i > 0 && quality < cut.quality_threshold {
@@ -506,6 +617,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         bounds: &Aabb,
         axes: [bool; 3],
         nb: u32,
+        binner: &impl NodeBinner,
     ) -> [Option<BinMap>; 3] {
         let maps: [Option<BinMap>; 3] = core::array::from_fn(|axis| {
             if !axes[axis] {
@@ -523,7 +635,9 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         });
         for (bins, map) in arena.bins.iter_mut().zip(&maps) {
             if map.is_some() {
-                bins[..nb as usize].fill(Bin::EMPTY);
+                // Up to a multiple of four: empty bins past the last add boundaries with an
+                // empty side, which never win, and let the sweep run with a constant length.
+                bins[..(nb as usize).next_multiple_of(4)].fill(Bin::EMPTY);
             }
         }
         // All three axes' bin indices in one 4-wide evaluation; an axis that is not binned gets
@@ -539,18 +653,46 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         };
         let (min, scale, last) = (lane(|m| m.min), lane(|m| m.scale), lane(|m| m.last));
         let active = [maps[0].is_some(), maps[1].is_some(), maps[2].is_some()];
-        let refs = &arena.refs;
-        for i in task.start as usize..(task.start + task.count) as usize {
-            let r = refs.get(i);
-            let (lo, hi) = (r.lo4(), r.hi4());
-            let index = ((lo + hi - min) * scale)
-                .fast_max(f32x4::ZERO)
-                .fast_min(last)
-                .fast_trunc_int()
-                .to_array();
-            for axis in 0..3 {
-                if active[axis] {
-                    arena.bins[axis][index[axis] as usize].grow(lo, hi);
+        let slots = arena.refs.slots(task.start as usize, task.count as usize);
+        let job = BinJob {
+            refs: slots,
+            min,
+            scale,
+            last,
+        };
+        if let Some(parts) = binner.bin(&job) {
+            arena.bins = parts.bins;
+        } else if active == [true; 3] {
+            // The common case (every axis has extent): no per-primitive branch.
+            if slots.len() >= DUAL_BINNING_MIN {
+                let nbp = (nb as usize).next_multiple_of(4);
+                for bins in &mut arena.bins2 {
+                    bins[..nbp].fill(Bin::EMPTY);
+                }
+                job.bin_into_dual(slots, &mut arena.bins, &mut arena.bins2);
+                for (mine, theirs) in arena.bins.iter_mut().zip(&arena.bins2) {
+                    for (a, b) in mine[..nbp].iter_mut().zip(&theirs[..nbp]) {
+                        a.merge(b);
+                    }
+                }
+            } else {
+                job.bin_into(slots, &mut arena.bins);
+            }
+        } else {
+            let [bx, by, bz] = &mut arena.bins;
+            let bins = [bx, by, bz];
+            for r in slots {
+                let (lo, hi) = (r.lo4(), r.hi4());
+                let i = ((lo + hi - min) * scale)
+                    .fast_max(f32x4::ZERO)
+                    .fast_min(last)
+                    .fast_trunc_int()
+                    .to_array()
+                    .map(|i| i as usize & (MAX_BINS as usize - 1));
+                for axis in 0..3 {
+                    if active[axis] {
+                        bins[axis][i[axis]].grow(lo, hi);
+                    }
                 }
             }
         }
@@ -561,7 +703,40 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
 /// The cheapest boundary of one binned axis under `model`. A suffix and a prefix pass write the
 /// boxes and counts on both sides of every boundary into SoA scratch lanes; the boundaries are
 /// then priced four at a time with [`CostModel::measure4`]. O(bins), no allocation.
+///
+/// The usual bin counts get a copy each with the count a constant, so the passes unroll without
+/// bounds checks; most nodes are small, and there this loop overhead was most of the sweep.
 fn sweep_axis<M: CostModel>(
+    bins: &[Bin],
+    sweep: &mut Sweep,
+    axis: usize,
+    map: BinMap,
+    model: &M,
+    hint: u32,
+) -> Option<Split> {
+    match bins.len() {
+        4 => sweep_bins::<M, 4>(bins[..4].try_into().ok()?, sweep, axis, map, model, hint),
+        8 => sweep_bins::<M, 8>(bins[..8].try_into().ok()?, sweep, axis, map, model, hint),
+        12 => sweep_bins::<M, 12>(bins[..12].try_into().ok()?, sweep, axis, map, model, hint),
+        16 => sweep_bins::<M, 16>(bins[..16].try_into().ok()?, sweep, axis, map, model, hint),
+        _ => sweep_any(bins, sweep, axis, map, model, hint),
+    }
+}
+
+#[inline(always)]
+fn sweep_bins<M: CostModel, const NB: usize>(
+    bins: &[Bin; NB],
+    sweep: &mut Sweep,
+    axis: usize,
+    map: BinMap,
+    model: &M,
+    hint: u32,
+) -> Option<Split> {
+    sweep_any(bins, sweep, axis, map, model, hint)
+}
+
+#[inline(always)]
+fn sweep_any<M: CostModel>(
     bins: &[Bin],
     sweep: &mut Sweep,
     axis: usize,
@@ -581,9 +756,10 @@ fn sweep_axis<M: CostModel>(
         acc.merge(&bins[i - 1]);
         sweep.left.set(i, &acc);
     }
-    for i in nb..nb + 3 {
-        sweep.left.set(i, &Bin::EMPTY);
-        sweep.right.set(i, &Bin::EMPTY);
+    // Lanes past the last boundary, up to the end of its group of four: no primitive on the
+    // right prices them as +inf.
+    for i in nb..=(nb - 1).div_ceil(4) * 4 {
+        sweep.right.count[i] = 0;
     }
     // The cheapest boundary per lane, then across lanes. Boundaries with an empty side, and the
     // padding lanes past the last boundary (count 0), price as +inf. Strict `<` keeps the first
@@ -607,15 +783,18 @@ fn sweep_axis<M: CostModel>(
         index += f32x4::splat(4.0);
     }
     let (w, i) = (best_w.to_array(), best_i.to_array());
-    let mut best: Option<(f32, usize, usize)> = None;
+    // `<` against +inf also drops NaN and infinite prices. The boundary stays a float until the
+    // winner is known: a saturating float-to-integer conversion per lane costs more than the rest.
+    let (mut weighted, mut at, mut won) = (f32::INFINITY, f32::INFINITY, 0);
     for lane in 0..4 {
-        let better = best
-            .is_none_or(|(bw, bi, _)| w[lane] < bw || (w[lane] == bw && (i[lane] as usize) < bi));
-        if w[lane].is_finite() && better {
-            best = Some((w[lane], i[lane] as usize, lane));
+        if w[lane] < weighted || (w[lane] == weighted && i[lane] < at) {
+            (weighted, at, won) = (w[lane], i[lane], lane);
         }
     }
-    let (weighted, bin, lane) = best?;
+    if !weighted.is_finite() {
+        return None;
+    }
+    let bin = at as usize;
     Some(Split {
         axis,
         map,
@@ -624,10 +803,63 @@ fn sweep_axis<M: CostModel>(
         right: sweep.right.bounds(bin),
         n_left: sweep.left.count[bin],
         n_right: sweep.right.count[bin],
-        measure_left: best_ml.to_array()[lane],
-        measure_right: best_mr.to_array()[lane],
+        measure_left: best_ml.to_array()[won],
+        measure_right: best_mr.to_array()[won],
         weighted,
     })
+}
+
+/// The split of a two-primitive node, without binning or sweeping, and the very split they would
+/// choose: along an axis where the two centroids differ they fall in the first and the last
+/// centroid bin, so every boundary between splits them alike at the same price, and the sweep
+/// keeps the lowest boundary, 1. Among the `axes` in the order they would be swept, the first
+/// that separates the centroids wins (a later axis prices the same split no lower); `None` when
+/// `axis` does not separate them. Half the
+/// nodes a SAH build prices hold two primitives. The price comes from [`CostModel::measure4`],
+/// like the sweep's, so it is bit for bit the sweep's.
+fn split_pair<M: CostModel>(
+    model: &M,
+    arena: &BuildArena,
+    task: &Task,
+    axis: usize,
+    nb: u32,
+) -> Option<Split> {
+    let map = pair_map(task, axis, nb)?;
+    let s = task.start as usize;
+    let (mut left, mut right) = (s, s + 1);
+    if arena.refs.centroid2_axis(s, axis) > arena.refs.centroid2_axis(s + 1, axis) {
+        (left, right) = (right, left);
+    }
+    let (left, right) = (arena.refs.bounds(left), arena.refs.bounds(right));
+    let lanes = |f: fn(&Aabb) -> glam::Vec3| {
+        let (l, r) = (f(&left), f(&right));
+        core::array::from_fn(|k| f32x4::from([l[k], r[k], r[k], r[k]]))
+    };
+    let m = model
+        .measure4(&Aabb4 {
+            min: lanes(|b| b.min),
+            max: lanes(|b| b.max),
+        })
+        .to_array();
+    Some(Split {
+        axis,
+        map,
+        bin: 1,
+        left,
+        right,
+        n_left: 1,
+        n_right: 1,
+        measure_left: m[0],
+        measure_right: m[1],
+        weighted: m[0] * 1.0 + m[1] * 1.0,
+    })
+}
+
+/// The bin map of a two-primitive node along `axis`, as [`Builder::bin`] makes it, or `None`
+/// where the centroids coincide.
+fn pair_map(task: &Task, axis: usize, nb: u32) -> Option<BinMap> {
+    let (lo, hi) = (task.centroids.min[axis], task.centroids.max[axis]);
+    (hi > lo).then(|| BinMap::new(lo, hi, nb)).flatten()
 }
 
 /// `ceil(log2(n))` for `n >= 1`.
@@ -639,10 +871,34 @@ fn ceil_log2(n: u32) -> u32 {
 /// Partitions the node's slots in place by the split's bin boundary. The child boxes come from
 /// the bins; the children's centroid bounds are gathered as each slot is classified.
 fn partition(arena: &mut BuildArena, task: &Task, split: &Split) -> (Child, Child) {
+    // Finding the threshold costs a few dozen bin evaluations: small nodes classify by bin.
+    if task.count <= THRESHOLD_MIN_COUNT {
+        partition_by(arena, task, split, |c| split.map.bin(c) < split.bin)
+    } else {
+        let threshold = split.map.threshold(split.bin);
+        partition_by(arena, task, split, |c| c < threshold)
+    }
+}
+
+/// Nodes of at least this size are binned into two sets of bins, even and odd slots apart, then
+/// merged: neighbouring primitives of a mesh often fall in the same bins, and growing one bin
+/// twice in a row waits on the store of the first growth.
+const DUAL_BINNING_MIN: usize = 256;
+
+/// Nodes above this size partition by [`BinMap::threshold`].
+const THRESHOLD_MIN_COUNT: u32 = 16;
+
+/// [`partition`] with the classification `goes_left` of a doubled centroid coordinate.
+#[inline(always)]
+fn partition_by(
+    arena: &mut BuildArena,
+    task: &Task,
+    split: &Split,
+    goes_left: impl Fn(f32) -> bool,
+) -> (Child, Child) {
     let refs = &mut arena.refs;
     let axis = split.axis;
-    let goes_left =
-        |refs: &PrimRefs, i: usize| split.map.bin(refs.centroid2_axis(i, axis)) < split.bin;
+    let goes_left = |refs: &PrimRefs, i: usize| goes_left(refs.centroid2_axis(i, axis));
     // Hoare's scheme: only misplaced pairs are swapped. The child centroid bounds are gathered in
     // 4-wide lanes as each slot settles on its side (lane 3 carries id bits and is dropped).
     let inf = f32x4::splat(f32::INFINITY);
@@ -678,16 +934,6 @@ fn partition(arena: &mut BuildArena, task: &Task, split: &Split) -> (Child, Chil
     (
         (split.left, split.n_left, lanes_to_aabb(l_lo, l_hi)),
         (split.right, split.n_right, lanes_to_aabb(r_lo, r_hi)),
-    )
-}
-
-/// An [`Aabb`] from `(x, y, z, _)` lanes.
-#[inline(always)]
-fn lanes_to_aabb(lo: f32x4, hi: f32x4) -> Aabb {
-    let (lo, hi) = (lo.to_array(), hi.to_array());
-    Aabb::new(
-        glam::Vec3::new(lo[0], lo[1], lo[2]),
-        glam::Vec3::new(hi[0], hi[1], hi[2]),
     )
 }
 
@@ -880,6 +1126,29 @@ mod tests {
             bad.build(&soup(3, 1)),
             Err(BuildError::InvalidConfig(_))
         ));
+    }
+
+    #[test]
+    fn threshold_classifies_like_the_bins() {
+        let mut rng = crate::random::Pcg32::new(5);
+        for round in 0..2000 {
+            // Offsets far from the origin make `min + bin / scale` cancel badly.
+            let offset = [0.0, 1e3, -1e5, 3e7][round % 4];
+            let lo = offset + rng.range(-10.0, 10.0);
+            let hi = lo + rng.range(1e-4, 20.0);
+            let nb = 2 + (round as u32 % 15);
+            let Some(map) = BinMap::new(lo, hi, nb) else {
+                continue;
+            };
+            for bin in 1..nb as usize {
+                let t = map.threshold(bin);
+                assert!(map.bin(t) >= bin && map.bin(t.next_down()) < bin);
+                for _ in 0..20 {
+                    let c = lo + rng.range(0.0, 1.0) * (hi - lo);
+                    assert_eq!(c < t, map.bin(c) < bin, "{map:?} bin {bin} c {c} t {t}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -38,27 +38,34 @@ impl Bvh {
         if jobs.len() != subtrees.len() {
             return Err(GraftError::CountMismatch);
         }
-        let mut nodes = top.nodes;
+        let top_nodes = top.nodes;
         let mut prim_indices = top.prim_indices;
         let mut max_depth = top.max_depth;
+        // Which job, if any, each top node is the placeholder of.
+        let mut job_of = alloc::vec![u32::MAX; top_nodes.len()];
+        let mut total = top_nodes.len();
         for (j, (job, sub)) in jobs.iter().zip(subtrees).enumerate() {
             let bad = GraftError::BadSubtree { job: j };
             let (start, count) = (job.start as usize, job.count as usize);
-            let placeholder = nodes.get(job.node as usize).ok_or(bad)?;
-            if !placeholder.is_leaf() || sub.prim_indices.len() != count || sub.nodes.is_empty() {
+            let placeholder = top_nodes.get(job.node as usize).ok_or(bad)?;
+            let slot = &mut job_of[job.node as usize];
+            if !placeholder.is_leaf()
+                || sub.prim_indices.len() != count
+                || sub.nodes.is_empty()
+                || *slot != u32::MAX
+            {
                 return Err(bad);
             }
+            *slot = j as u32;
             prim_indices
                 .get_mut(start..start + count)
                 .ok_or(bad)?
                 .copy_from_slice(&sub.prim_indices);
             max_depth = max_depth.max(sub.max_depth);
-            let offset = nodes.len() as u32;
-            nodes[job.node as usize] = place(&sub.nodes[0], job.start, offset);
-            nodes.extend(sub.nodes[1..].iter().map(|n| place(n, job.start, offset)));
+            total += sub.nodes.len() - 1;
         }
         Ok(Bvh {
-            nodes: canonical_order(&nodes),
+            nodes: canonical_layout(&top_nodes, &job_of, jobs, subtrees, total),
             prim_indices,
             max_depth,
         })
@@ -79,33 +86,56 @@ fn place(n: &BvhNode, start: u32, offset: u32) -> BvhNode {
     }
 }
 
-/// The nodes re-laid out as the builder allocates them: root first; splitting a node appends its
-/// two children; the left subtree is finished before the right one is opened.
-fn canonical_order(nodes: &[BvhNode]) -> Vec<BvhNode> {
-    let mut out = Vec::with_capacity(nodes.len());
-    if nodes.is_empty() {
+/// The whole tree laid out as the single-threaded builder allocates it, in one pass: root first;
+/// splitting a node appends its two children; the left subtree is finished before the right one
+/// is opened. A job's subtree is built without interruption there, so its nodes after its root
+/// form one block, in the subtree's own order, placed when the walk over the top reaches the
+/// job: only the top nodes are walked, and each subtree is one block copy.
+fn canonical_layout(
+    top: &[BvhNode],
+    job_of: &[u32],
+    jobs: &[Subtree],
+    subtrees: &[Bvh],
+    total: usize,
+) -> Vec<BvhNode> {
+    let mut out: Vec<BvhNode> = alloc::vec![bytemuck::Zeroable::zeroed(); total];
+    if top.is_empty() {
         return out;
     }
-    out.push(nodes[0]);
-    // (old index, new index) of nodes whose children are not placed yet.
+    out[0] = top[0];
+    let mut next = 1usize;
+    // (top index, new index) of nodes whose subtrees are not laid out yet.
     let mut pending: Vec<(u32, u32)> = Vec::new();
     let mut current = (0u32, 0u32);
     loop {
-        let node = nodes[current.0 as usize];
-        if !node.is_leaf() {
-            let (l_old, l_new) = (node.left_first, out.len() as u32);
-            out.push(nodes[l_old as usize]);
-            out.push(nodes[l_old as usize + 1]);
-            out[current.1 as usize].left_first = l_new;
-            pending.push((l_old + 1, l_new + 1));
-            current = (l_old, l_new);
+        let (old, new) = (current.0 as usize, current.1 as usize);
+        let j = job_of[old];
+        if j != u32::MAX {
+            let (job, sub) = (&jobs[j as usize], &subtrees[j as usize]);
+            let offset = next as u32;
+            out[new] = place(&sub.nodes[0], job.start, offset);
+            let block = &mut out[next..next + sub.nodes.len() - 1];
+            for (dst, n) in block.iter_mut().zip(&sub.nodes[1..]) {
+                *dst = place(n, job.start, offset);
+            }
+            next += sub.nodes.len() - 1;
+        } else if !top[old].is_leaf() {
+            let l_old = top[old].left_first as usize;
+            let l_new = next as u32;
+            out[next] = top[l_old];
+            out[next + 1] = top[l_old + 1];
+            next += 2;
+            out[new].left_first = l_new;
+            pending.push((l_old as u32 + 1, l_new + 1));
+            current = (l_old as u32, l_new);
             continue;
         }
         match pending.pop() {
-            Some(next) => current = next,
+            Some(p) => current = p,
             None => break,
         }
     }
+    debug_assert_eq!(next, total);
     out
 }
 

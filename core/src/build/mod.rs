@@ -6,13 +6,15 @@
 //! front, and the output [`crate::bvh::Bvh`] can be pre-sized too, so a build allocates nothing.
 
 mod arena;
+mod binning;
 mod builder;
 mod config;
 mod graft;
 mod preset;
 mod profile;
 
-pub use arena::BuildArena;
+pub use arena::{BuildArena, LoadedBounds, TriangleLoad};
+pub use binning::{BinJob, NodeBinner, NodeBins, SerialBinner};
 pub use builder::{BuildStats, Builder, Subtree};
 pub use config::{BinSpace, BuildConfig, CutEvaluation, ThesisCut, MAX_BINS};
 pub use graft::GraftError;

@@ -1,0 +1,165 @@
+//! `build_profile SCENE [REPS]`: rdbvh's single-threaded SAH build alone, for profilers and quick
+//! before/after checks of the builder. Prints the best thread CPU time of `REPS` builds (default
+//! 7), the tree's SAH cost, its node count and a hash of its nodes and leaf order (two builds with
+//! the same hash made the same tree), then the threaded build's best wall time on the global pool
+//! and on one thread, the single-threaded build's best wall time (the `peers` scaling is that
+//! over the threaded build's) and whether the threaded tree equals the single-threaded one.
+//!
+//! `RDBVH_PROFILE_PAH=1` adds the `full` preset (PAH + SPFH) over the `peers` table's plane and
+//! point areas: CPU time, its ratio to the SAH build's, and the tree's hash.
+//!
+//! Under `valgrind --tool=callgrind --toggle-collect=build_profile::build_once`, only the builds
+//! (loading the triangle bounds included) are counted; `RDBVH_PROFILE_MT=0` skips the threaded
+//! part, so callgrind runs stay short.
+
+use std::hash::{Hash, Hasher};
+use std::hint::black_box;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use rdbvh_benches::compare::{plane_area_over, point_area_over};
+use rdbvh_benches::{load_scene, thread_cpu_seconds};
+use rdbvh_core::build::{BuildArena, Builder, Preset, PresetOptions};
+use rdbvh_core::bvh::Bvh;
+use rdbvh_core::geometry::Triangle;
+use rdbvh_core::heuristics::{CostConstants, Sah};
+use rdbvh_core::influence::InfluenceArea;
+
+/// One timed build: loading the bounds and the binned SAH build, as the `peers` table times it.
+#[inline(never)]
+fn build_once(tris: &[Triangle]) -> Bvh {
+    Builder::sah().build(black_box(tris)).expect("finite scene")
+}
+
+/// One threaded build on the current rayon pool.
+#[inline(never)]
+fn build_mt_once(tris: &[Triangle]) -> Bvh {
+    rdbvh::parallel::build(&Builder::sah(), black_box(tris)).expect("finite scene")
+}
+
+fn tree_hash(bvh: &Bvh) -> u64 {
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for n in bvh.nodes() {
+        bytemuck_bits(n).hash(&mut h);
+    }
+    bvh.prim_indices().hash(&mut h);
+    h.finish()
+}
+
+fn bytemuck_bits(n: &rdbvh_core::bvh::BvhNode) -> [u32; 8] {
+    let b = n.bounds();
+    let (lo, hi) = (b.min, b.max);
+    [
+        lo.x.to_bits(),
+        lo.y.to_bits(),
+        lo.z.to_bits(),
+        hi.x.to_bits(),
+        hi.y.to_bits(),
+        hi.z.to_bits(),
+        n.left_first,
+        n.count,
+    ]
+}
+
+fn best_wall(reps: usize, mut f: impl FnMut() -> Bvh) -> f64 {
+    (0..reps)
+        .map(|_| {
+            let t = Instant::now();
+            drop(black_box(f()));
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn main() -> ExitCode {
+    let mut args = std::env::args().skip(1);
+    let Some(scene) = args.next() else {
+        eprintln!("usage: build_profile SCENE [REPS]");
+        return ExitCode::FAILURE;
+    };
+    let reps: usize = args.next().and_then(|r| r.parse().ok()).unwrap_or(7);
+    let tris = match load_scene(&scene) {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let n = tris.len();
+    let mut best = f64::INFINITY;
+    let mut bvh = Bvh::default();
+    for _ in 0..reps {
+        let t = thread_cpu_seconds();
+        bvh = build_once(&tris);
+        best = best.min(thread_cpu_seconds() - t);
+    }
+    let cost = bvh.estimated_cost(&Sah, CostConstants::default());
+    let hash = tree_hash(&bvh);
+    println!(
+        "{scene}: {n} tris; build_1t {:.2} ms ({:.2} Mtris/s, thread CPU, best of {reps}); \
+         sah_cost {cost:.4}; nodes {}; tree {hash:016x}",
+        best * 1e3,
+        n as f64 / best * 1e-6,
+        bvh.nodes().len()
+    );
+    // PAH: the `full` preset (PAH + SPFH) with the plane and point areas the `peers` table uses.
+    if std::env::var("RDBVH_PROFILE_PAH").is_ok_and(|v| v == "1") {
+        let b = tris.iter().fold(rdbvh_core::geometry::Aabb::EMPTY, |b, t| {
+            b.union(t.bounds())
+        });
+        let areas: [(&str, InfluenceArea); 2] = [
+            ("plane", plane_area_over(&b).expect("plane").into()),
+            ("point", point_area_over(&b).expect("point").into()),
+        ];
+        for (name, area) in &areas {
+            let mut arena = BuildArena::with_capacity(n);
+            let mut out = Bvh::with_capacity(n);
+            let mut best_pah = f64::INFINITY;
+            for _ in 0..reps {
+                let t = thread_cpu_seconds();
+                arena.load_triangles(&tris).expect("finite");
+                Preset::Full
+                    .build_into(Some(area), &PresetOptions::default(), &mut arena, &mut out)
+                    .expect("pah build");
+                best_pah = best_pah.min(thread_cpu_seconds() - t);
+            }
+            println!(
+                "  full {name} area: {:.2} ms ({:.2}x the SAH build); tree {:016x}",
+                best_pah * 1e3,
+                best_pah / best,
+                tree_hash(&out)
+            );
+        }
+    }
+    if std::env::var("RDBVH_PROFILE_MT").is_ok_and(|v| v == "0") {
+        return ExitCode::SUCCESS;
+    }
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("pool");
+    let mt = build_mt_once(&tris);
+    let same = mt == bvh;
+    let wall_mt = best_wall(reps, || build_mt_once(&tris));
+    let wall_1 = one.install(|| best_wall(reps, || build_mt_once(&tris)));
+    let wall_serial = best_wall(reps, || build_once(&tris));
+    println!(
+        "  parallel::build: {} threads {:.2} ms, 1 thread {:.2} ms ({:.2}x); single-threaded \
+         build {:.2} ms wall, scaling {:.2}x (as peers: 1t build / threaded); same tree as 1t: \
+         {same}; load {:?}",
+        rayon::current_num_threads(),
+        wall_mt * 1e3,
+        wall_1 * 1e3,
+        wall_1 / wall_mt,
+        wall_serial * 1e3,
+        wall_serial / wall_mt,
+        std::fs::read_to_string("/proc/loadavg")
+            .unwrap_or_default()
+            .trim()
+    );
+    if same {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}

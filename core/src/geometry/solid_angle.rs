@@ -27,9 +27,12 @@ pub fn box_solid_angle4(lo: &[f32x4; 3], hi: &[f32x4; 3]) -> f32x4 {
     let sq: [[f32x4; 2]; 3] = core::array::from_fn(|k| [c[k][0] * c[k][0], c[k][1] * c[k][1]]);
     let (mut re, mut im) = (f32x4::ONE, zero);
     for k in 0..3 {
-        let (a1, a2) = ((k + 1) % 3, (k + 2) % 3);
-        let below = c[k][0].simd_gt(zero);
-        let visible = below | c[k][1].simd_lt(zero);
+        let Face {
+            a1,
+            a2,
+            below,
+            visible,
+        } = facing(&c, k);
         if visible.to_bitmask() == 0 {
             continue;
         }
@@ -90,9 +93,12 @@ pub fn far_field4(lo: &[f32x4; 3], hi: &[f32x4; 3], depth: impl Fn(&[f32x4; 3]) 
     let mid: [f32x4; 3] = core::array::from_fn(|k| (c[k][0] + c[k][1]) * half);
     let mut total = zero;
     for k in 0..3 {
-        let (a1, a2) = ((k + 1) % 3, (k + 2) % 3);
-        let below = c[k][0].simd_gt(zero);
-        let visible = below | c[k][1].simd_lt(zero);
+        let Face {
+            a1,
+            a2,
+            below,
+            visible,
+        } = facing(&c, k);
         if visible.to_bitmask() == 0 {
             continue;
         }
@@ -113,6 +119,30 @@ pub fn box_solid_angle_far4(lo: &[f32x4; 3], hi: &[f32x4; 3]) -> f32x4 {
         let r2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
         r2 * r2.sqrt()
     })
+}
+
+/// The face of the boxes on axis `k` that the eye sees, one per axis at most: the one at the
+/// minimum where the eye is below the slab, at the maximum where above, none where inside it.
+struct Face {
+    /// The other two axes, in cyclic order.
+    a1: usize,
+    a2: usize,
+    /// Lanes whose eye is below the slab (they see the face at the minimum).
+    below: f32x4,
+    /// Lanes that see a face on this axis at all.
+    visible: f32x4,
+}
+
+/// The face on axis `k` of the scaled bounds `c` (`visible` is empty when no lane sees one).
+#[inline(always)]
+fn facing(c: &[[f32x4; 2]; 3], k: usize) -> Face {
+    let below = c[k][0].simd_gt(f32x4::ZERO);
+    Face {
+        a1: (k + 1) % 3,
+        a2: (k + 2) % 3,
+        below,
+        visible: below | c[k][1].simd_lt(f32x4::ZERO),
+    }
 }
 
 /// The bounds scaled by the power of two of their largest magnitude (the exponent bits alone),

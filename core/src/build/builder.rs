@@ -810,13 +810,14 @@ fn sweep_any<M: CostModel>(
 }
 
 /// The split of a two-primitive node, without binning or sweeping, and the very split they would
-/// choose: along an axis where the two centroids differ they fall in the first and the last
-/// centroid bin, so every boundary between splits them alike at the same price, and the sweep
-/// keeps the lowest boundary, 1. Among the `axes` in the order they would be swept, the first
-/// that separates the centroids wins (a later axis prices the same split no lower); `None` when
-/// `axis` does not separate them. Half the
-/// nodes a SAH build prices hold two primitives. The price comes from [`CostModel::measure4`],
-/// like the sweep's, so it is bit for bit the sweep's.
+/// choose: the two centroids fall in bins `a <= b` (normally the first and the last), every
+/// boundary between them splits them alike at the same price, and the sweep keeps the lowest,
+/// `a + 1`. Among the `axes` in the order they would be swept, the first that separates the
+/// centroids wins (a later axis prices the same split no lower); `None` when `axis` does not
+/// separate them, which includes centroids that differ but share a bin (at extreme coordinates
+/// the extent overflows and the bin scale rounds to zero: the sweep finds no split there either).
+/// Half the nodes a SAH build prices hold two primitives. The price comes from
+/// [`CostModel::measure4`], like the sweep's, so it is bit for bit the sweep's.
 fn split_pair<M: CostModel>(
     model: &M,
     arena: &BuildArena,
@@ -829,6 +830,13 @@ fn split_pair<M: CostModel>(
     let (mut left, mut right) = (s, s + 1);
     if arena.refs.centroid2_axis(s, axis) > arena.refs.centroid2_axis(s + 1, axis) {
         (left, right) = (right, left);
+    }
+    let (bin_left, bin_right) = (
+        map.bin(arena.refs.centroid2_axis(left, axis)),
+        map.bin(arena.refs.centroid2_axis(right, axis)),
+    );
+    if bin_left >= bin_right {
+        return None;
     }
     let (left, right) = (arena.refs.bounds(left), arena.refs.bounds(right));
     let lanes = |f: fn(&Aabb) -> glam::Vec3| {
@@ -844,7 +852,7 @@ fn split_pair<M: CostModel>(
     Some(Split {
         axis,
         map,
-        bin: 1,
+        bin: bin_left + 1,
         left,
         right,
         n_left: 1,
@@ -1082,6 +1090,37 @@ mod tests {
             .unwrap();
         assert_eq!(bvh.leaf_count(), 1000);
         assert!(bvh.max_depth() <= 10, "depth {}", bvh.max_depth());
+    }
+
+    /// Found by the `build_query` fuzz target: two triangles near +-f32::MAX whose doubled
+    /// centroids overflow to +-inf, so the bin scale rounds to zero and both fall in bin 0. The
+    /// two-primitive shortcut assumed the first and the last bin, put both primitives on the left
+    /// and gave the left child the other primitive's box.
+    #[test]
+    fn two_primitives_sharing_a_bin_are_not_split_by_it() {
+        // Thin in y and z, so the node's surface area stays finite while the centroids'
+        // extent (6e38) does not.
+        let at = |x: f32| {
+            Triangle::new(
+                Vec3::new(x, 0.0, 0.0),
+                Vec3::new(x, 1e-3, 0.0),
+                Vec3::new(x, 0.0, 1e-3),
+            )
+        };
+        // The larger centroid first, so a wrong split would show in the boxes.
+        let tris = [at(1.5e38), at(-1.5e38)];
+        for bvh in [Builder::sah().build(&tris), Builder::lsph().build(&tris)] {
+            let bvh = bvh.unwrap();
+            bvh.validate(tris.len(), |i| tris[i as usize].bounds())
+                .unwrap();
+            for x in [1.5e38f32, -1.5e38] {
+                let ray = Ray::new(Vec3::new(x, 2e-4, -1.0), Vec3::Z).unwrap();
+                assert_eq!(
+                    bvh.closest_hit(&ray, &tris),
+                    crate::brute_force::closest_hit(&ray, &tris)
+                );
+            }
+        }
     }
 
     #[test]

@@ -186,8 +186,10 @@ mod tests {
     fn lanes_match_the_scalar_test_bit_for_bit() {
         let mut rng = Pcg32::new(4);
         let mut v = |s: f32| Vec3::new(rng.range(-s, s), rng.range(-s, s), rng.range(-s, s));
+        // Miri runs a tenth of the cases (the CI's Miri pass covers geometry::).
+        let cases = if cfg!(miri) { 40 } else { 400 };
         let mut tris = Vec::new();
-        for i in 0..400 {
+        for i in 0..cases {
             let a = v(4.0);
             let (b, c) = match i % 8 {
                 // Degenerate: a segment and a point.
@@ -204,7 +206,7 @@ mod tests {
             tris.push(Triangle::new(a, b, c));
         }
         let mut rays = Vec::new();
-        for i in 0..400 {
+        for i in 0..cases {
             let o = v(6.0);
             let t = &tris[i % tris.len()];
             let d = match i % 6 {
@@ -254,6 +256,6 @@ mod tests {
                 }
             }
         }
-        assert!(hits > 100, "too few hits ({hits}) to mean anything");
+        assert!(hits > cases / 4, "too few hits ({hits}) to mean anything");
     }
 }

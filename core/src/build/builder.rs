@@ -839,15 +839,8 @@ fn split_pair<M: CostModel>(
         return None;
     }
     let (left, right) = (arena.refs.bounds(left), arena.refs.bounds(right));
-    let lanes = |f: fn(&Aabb) -> glam::Vec3| {
-        let (l, r) = (f(&left), f(&right));
-        core::array::from_fn(|k| f32x4::from([l[k], r[k], r[k], r[k]]))
-    };
     let m = model
-        .measure4(&Aabb4 {
-            min: lanes(|b| b.min),
-            max: lanes(|b| b.max),
-        })
+        .measure4(&Aabb4::from_boxes([left, right, right, right]))
         .to_array();
     Some(Split {
         axis,

@@ -105,14 +105,14 @@ impl PahOrtho {
         f32x4::splat(w.x) * ey * ez + f32x4::splat(w.y) * ex * ez + f32x4::splat(w.z) * ex * ey
     }
 
-    /// True when the projection of `b` lies inside the window `w`: along each window axis the
-    /// projection spans the centre's coordinate +- the sum of `|axis_k| e_k / 2`.
+    /// The lower and upper corners, in window coordinates, of the projection of `b`: along each
+    /// window axis the projection spans the centre's coordinate +- the sum of `|axis_k| e_k / 2`.
     #[inline]
-    fn projects_inside(w: &Window, b: &Aabb) -> bool {
+    fn window_span(w: &Window, b: &Aabb) -> (Vec2, Vec2) {
         let (c, h) = (b.center(), b.extent() * 0.5);
-        let (cx, hx) = (c.dot(w.right), h.dot(w.right.abs()));
-        let (cy, hy) = (c.dot(w.up), h.dot(w.up.abs()));
-        cx - hx >= w.lo.x && cx + hx <= w.hi.x && cy - hy >= w.lo.y && cy + hy <= w.hi.y
+        let centre = Vec2::new(c.dot(w.right), c.dot(w.up));
+        let half = Vec2::new(h.dot(w.right.abs()), h.dot(w.up.abs()));
+        (centre - half, centre + half)
     }
 
     /// The exact projected area of `b` inside the window `w`: hull of the eight projected
@@ -134,13 +134,10 @@ impl CostModel for PahOrtho {
         let Some(w) = &self.window else {
             return full;
         };
-        // The projection's extent along each window axis: centre +- sum of |axis_k| e_k / 2.
-        let (c, h) = (b.center(), b.extent() * 0.5);
-        let (cx, hx) = (c.dot(w.right), h.dot(w.right.abs()));
-        let (cy, hy) = (c.dot(w.up), h.dot(w.up.abs()));
-        if Self::projects_inside(w, b) {
+        let (lo, hi) = Self::window_span(w, b);
+        if lo.cmpge(w.lo).all() && hi.cmple(w.hi).all() {
             full
-        } else if cx + hx <= w.lo.x || cx - hx >= w.hi.x || cy + hy <= w.lo.y || cy - hy >= w.hi.y {
+        } else if hi.cmple(w.lo).any() || lo.cmpge(w.hi).any() {
             0.0
         } else {
             Self::clipped_area(w, b)
@@ -202,7 +199,10 @@ impl CostModel for PahOrtho {
     /// 1 when the node's projection lies inside the window: then so does every box inside it.
     fn hint(&self, node: &Aabb) -> u32 {
         match &self.window {
-            Some(w) if !node.is_empty() => u32::from(Self::projects_inside(w, node)),
+            Some(w) if !node.is_empty() => {
+                let (lo, hi) = Self::window_span(w, node);
+                u32::from(lo.cmpge(w.lo).all() && hi.cmple(w.hi).all())
+            }
             _ => 0,
         }
     }

@@ -27,9 +27,12 @@ pub enum PerspectiveMeasure {
 /// PAH for rays from a point: the box's silhouette seen from the eye, clipped to the frustum's
 /// fields of view and measured by solid angle or image-plane area. Rays start on the near plane
 /// (as the thesis cast them), so the box is first cut at the near plane: only its part beyond it can
-/// be hit. The silhouette of a convex body from a point in front of it is the convex hull of its
-/// projected vertices, so one hull of at most 14 points (8 corners, 6 near-plane cuts) and one
-/// rectangle clip give the exact measure, also for boxes that contain the eye.
+/// be hit. A box wholly inside the frustum is measured as the sum of its faces turned towards the
+/// eye, four boxes at a time (exact, or by the midpoint rule when it is far: see
+/// [`crate::geometry::far_field4`]). Any other box takes the hull path: the silhouette of a convex
+/// body from a point in front of it is the convex hull of its projected vertices, so one hull of at
+/// most 14 points (8 corners, 6 near-plane cuts) and one rectangle clip give the exact measure, also
+/// for boxes that contain the eye.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PahPerspective {
     eye: Vec3,
@@ -167,23 +170,26 @@ impl PahPerspective {
     #[inline(always)]
     fn front_faces4(&self, b: &Aabb4) -> (f32x4, f32x4) {
         let (rel_lo, rel_hi) = self.relative(b);
-        let half = f32x4::splat(0.5);
-        let c: [f32x4; 3] = core::array::from_fn(|k| (rel_lo[k] + rel_hi[k]) * half);
-        let h: [f32x4; 3] = core::array::from_fn(|k| (rel_hi[k] - rel_lo[k]) * half);
+        let (c, h) = centre_half(&rel_lo, &rel_hi);
         let inside = self.inside_pyramid4(&c, &h);
         let inside_bits = inside.to_bitmask();
         if inside_bits == 0 {
             return (f32x4::ZERO, inside);
         }
-        // Far from the eye the midpoint rule per face is as good as exact (see `far_field4`):
-        // half-diagonal^2 <= FAR_FIELD * distance^2 (or depth^2) in every lane that matters.
-        let reach = self.reach(&c);
-        let diag2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
-        let far = diag2.simd_le(reach * reach * f32x4::splat(FAR_FIELD));
-        if (far.to_bitmask() | !inside_bits) & 0b1111 == 0b1111 {
+        // Far from the eye the midpoint rule per face is as good as exact (see `far_field4`).
+        if (self.far_lanes(&c, &h).to_bitmask() | !inside_bits) & 0b1111 == 0b1111 {
             return (self.far4(&rel_lo, &rel_hi), inside);
         }
         (self.exact4(&rel_lo, &rel_hi), inside)
+    }
+
+    /// The lanes far enough from the eye for the midpoint rule (`far_field4`):
+    /// half-diagonal^2 <= FAR_FIELD * reach^2, for eye-relative centres `c` and half extents `h`.
+    #[inline(always)]
+    fn far_lanes(&self, c: &[f32x4; 3], h: &[f32x4; 3]) -> f32x4 {
+        let reach = self.reach(c);
+        let diag2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
+        diag2.simd_le(reach * reach * f32x4::splat(FAR_FIELD))
     }
 
     /// The boxes' bounds relative to the eye.
@@ -313,9 +319,7 @@ impl CostModel for PahPerspective {
     fn hint(&self, node: &Aabb) -> u32 {
         let b = Aabb4::splat(node);
         let (rel_lo, rel_hi) = self.relative(&b);
-        let half = f32x4::splat(0.5);
-        let c: [f32x4; 3] = core::array::from_fn(|k| (rel_lo[k] + rel_hi[k]) * half);
-        let h: [f32x4; 3] = core::array::from_fn(|k| (rel_hi[k] - rel_lo[k]) * half);
+        let (c, h) = centre_half(&rel_lo, &rel_hi);
         if self.inside_pyramid4(&c, &h).to_bitmask() & 1 == 0 {
             return 0;
         }
@@ -336,23 +340,18 @@ impl CostModel for PahPerspective {
             return self.measure4(b);
         }
         let (rel_lo, rel_hi) = self.relative(b);
+        let empty = b.empty();
         let m = if hint & HINT_FAR != 0 {
             self.far4(&rel_lo, &rel_hi)
         } else {
-            let half = f32x4::splat(0.5);
-            let c: [f32x4; 3] = core::array::from_fn(|k| (rel_lo[k] + rel_hi[k]) * half);
-            let h: [f32x4; 3] = core::array::from_fn(|k| (rel_hi[k] - rel_lo[k]) * half);
-            let reach = self.reach(&c);
-            let diag2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
-            let far = diag2.simd_le(reach * reach * f32x4::splat(FAR_FIELD));
-            let empty = b.empty();
-            if (far | empty).all() {
+            let (c, h) = centre_half(&rel_lo, &rel_hi);
+            if (self.far_lanes(&c, &h) | empty).all() {
                 self.far4(&rel_lo, &rel_hi)
             } else {
                 self.exact4(&rel_lo, &rel_hi)
             }
         };
-        b.empty().select(f32x4::ZERO, m)
+        empty.select(f32x4::ZERO, m)
     }
 
     /// Four boxes at once: the hull-free path for every lane inside the pyramid, zero for empty
@@ -375,6 +374,16 @@ impl CostModel for PahPerspective {
         }
         f32x4::from(out)
     }
+}
+
+/// The centres and half extents of boxes given by their bounds.
+#[inline(always)]
+fn centre_half(lo: &[f32x4; 3], hi: &[f32x4; 3]) -> ([f32x4; 3], [f32x4; 3]) {
+    let half = f32x4::splat(0.5);
+    (
+        core::array::from_fn(|k| (lo[k] + hi[k]) * half),
+        core::array::from_fn(|k| (hi[k] - lo[k]) * half),
+    )
 }
 
 /// [`PahPerspective::hint`]: every box inside the node is inside the pyramid.

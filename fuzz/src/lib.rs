@@ -206,8 +206,8 @@ pub fn expected_build_error(tris: &[Triangle]) -> Option<BuildError> {
     first_non_finite(tris).map(|index| BuildError::InvalidPrimitive { index })
 }
 
-/// A valid build configuration from the fuzz input: every bin count, depth bound, cut evaluation
-/// and bin space the builder accepts.
+/// A valid build configuration from the fuzz input: every bin count, depth bound, cut evaluation,
+/// bin space and exhaustive-split size the builder accepts.
 pub fn build_config(u: &mut Unstructured) -> Result<BuildConfig> {
     let bins = match u.int_in_range(0u8..=3)? {
         0 => 2,
@@ -231,11 +231,13 @@ pub fn build_config(u: &mut Unstructured) -> Result<BuildConfig> {
     } else {
         BinSpace::Centroids
     };
+    let exhaustive_max = u.int_in_range(0..=rdbvh_core::build::MAX_EXHAUSTIVE)?;
     Ok(BuildConfig {
         bins,
         max_depth,
         cut,
         bin_space,
+        exhaustive_max,
         ..BuildConfig::default()
     })
 }

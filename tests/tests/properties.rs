@@ -323,6 +323,7 @@ proptest! {
         bins in prop_oneof![Just(2u32), Just(3), Just(4), Just(7), Just(16), Just(64)],
         s in scale(),
         (cut, bin_space) in cut_and_space(),
+        exhaustive_max in 0u32..=rdbvh_core::build::MAX_EXHAUSTIVE,
     ) {
         // The scene's scale comes with the scene; `s` only scales free ray origins, so rays also
         // start far inside or far outside the scene.
@@ -331,7 +332,7 @@ proptest! {
         check_builder(&Builder::sah(), &tris, &rays, &mut arena);
         check_builder(&Builder::lsph(), &tris, &rays, &mut arena);
         check_builder(&thesis_builder(bins, rdbvh_core::bvh::MAX_DEPTH), &tris, &rays, &mut arena);
-        let config = BuildConfig { bins, cut, bin_space, ..BuildConfig::default() };
+        let config = BuildConfig { bins, cut, bin_space, exhaustive_max, ..BuildConfig::default() };
         let lsph_bins = Builder::new(LongestAxis, Sah, SahTermination { max_leaf: 4 }, config);
         check_builder(&lsph_bins, &tris, &rays, &mut arena);
         let all_axes = Builder::new(AllAxes, Sah, LeafSize { max_leaf: 1 }, config);

@@ -7,6 +7,7 @@ use glam::Vec3;
 use wide::f32x4;
 
 use super::config::MAX_BINS;
+use super::exhaustive::SUBSETS;
 use crate::bvh::MAX_DEPTH;
 use crate::geometry::{Aabb, Triangle};
 use crate::simd::Aabb4;
@@ -29,8 +30,14 @@ pub(crate) struct PrimRef {
 }
 
 impl PrimRef {
+    /// All zero: the filler of fixed scratch arrays.
+    pub const ZERO: PrimRef = PrimRef {
+        lo: [0.0; 4],
+        hi: [0.0; 4],
+    };
+
     #[inline(always)]
-    fn new(id: u32, b: &Aabb) -> Self {
+    pub(crate) fn new(id: u32, b: &Aabb) -> Self {
         Self {
             lo: [b.min.x, b.min.y, b.min.z, f32::from_bits(id)],
             hi: [b.max.x, b.max.y, b.max.z, 0.0],
@@ -87,6 +94,12 @@ impl PrimRefs {
     #[inline(always)]
     pub fn slots(&self, start: usize, count: usize) -> &[PrimRef] {
         &self.refs[start..start + count]
+    }
+
+    /// Slots `start..start + count`, to reorder.
+    #[inline(always)]
+    pub fn slots_mut(&mut self, start: usize, count: usize) -> &mut [PrimRef] {
+        &mut self.refs[start..start + count]
     }
 
     /// The ids in slot order.
@@ -196,22 +209,8 @@ impl SweepSide {
         model: &M,
         hint: u32,
     ) -> (f32x4, f32x4) {
-        let [min_x, min_y, min_z, _] = f32x4::transpose([
-            self.min[i],
-            self.min[i + 1],
-            self.min[i + 2],
-            self.min[i + 3],
-        ]);
-        let [max_x, max_y, max_z, _] = f32x4::transpose([
-            self.max[i],
-            self.max[i + 1],
-            self.max[i + 2],
-            self.max[i + 3],
-        ]);
-        let b4 = Aabb4 {
-            min: [min_x, min_y, min_z],
-            max: [max_x, max_y, max_z],
-        };
+        let lanes = |v: &[f32x4; SWEEP_LANES]| [v[i], v[i + 1], v[i + 2], v[i + 3]];
+        let b4 = soa(lanes(&self.min), lanes(&self.max));
         let c = &self.count;
         let n = f32x4::from([
             c[i] as f32,
@@ -220,6 +219,17 @@ impl SweepSide {
             c[i + 3] as f32,
         ]);
         (model.measure4_hinted(&b4, hint), n)
+    }
+}
+
+/// Four boxes given as `(x, y, z, _)` corner lanes, transposed into SoA lanes for pricing.
+#[inline(always)]
+pub(crate) fn soa(mins: [f32x4; 4], maxs: [f32x4; 4]) -> Aabb4 {
+    let [min_x, min_y, min_z, _] = f32x4::transpose(mins);
+    let [max_x, max_y, max_z, _] = f32x4::transpose(maxs);
+    Aabb4 {
+        min: [min_x, min_y, min_z],
+        max: [max_x, max_y, max_z],
     }
 }
 
@@ -254,6 +264,8 @@ pub struct BuildArena {
     /// A second set of bins, for large nodes binned in two interleaved halves.
     pub(crate) bins2: [[Bin; MAX_BINS as usize]; 3],
     pub(crate) sweep: Sweep,
+    /// The boxes of every subset of a node priced exhaustively.
+    pub(crate) subsets: [Bin; SUBSETS],
     pub(crate) tasks: Vec<Task>,
     pub(crate) bounds: Aabb,
     pub(crate) centroids: Aabb,
@@ -271,6 +283,7 @@ impl BuildArena {
                 left: SweepSide::new(),
                 right: SweepSide::new(),
             },
+            subsets: [Bin::EMPTY; SUBSETS],
             // The builder descends into one child and defers the other, so pending tasks are at
             // most one per level.
             tasks: Vec::with_capacity(MAX_DEPTH as usize + 2),

@@ -3,6 +3,7 @@
 use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRefs, Sweep, Task};
 use super::binning::{BinJob, NodeBinner, SerialBinner};
 use super::config::{BinSpace, BuildConfig, CutEvaluation, MAX_BINS};
+use super::exhaustive::{cheapest_bipartition, partition_by_mask};
 use super::profile::{Clock, NoClock, PhaseProfile};
 use crate::bvh::{Bvh, BvhNode};
 use alloc::vec::Vec;
@@ -11,7 +12,7 @@ use wide::f32x4;
 
 use crate::geometry::{Aabb, Triangle};
 use crate::heuristics::{
-    AllAxes, AxisChooser, CostModel, LongestAxis, Sah, SahTermination, Termination,
+    AllAxes, AxisChooser, AxisOrder, CostModel, LongestAxis, Sah, SahTermination, Termination,
 };
 use crate::simd::Aabb4;
 use crate::BuildError;
@@ -93,34 +94,34 @@ impl Builder<LongestAxis> {
 /// One side of a split: its bounds, primitive count and (doubled) centroid bounds.
 type Child = (Aabb, u32, Aabb);
 
-/// A candidate split at a bin boundary, with what pricing it under any cost model needs.
+/// A priced candidate split, with what pricing it under any other cost model needs: the cheapest
+/// bin boundary of a sweep along one axis, or the cheapest bipartition of a tiny node
+/// ([`super::exhaustive`]).
 #[derive(Clone, Copy, Debug)]
-struct Split {
-    axis: usize,
-    map: BinMap,
-    /// First bin of the right child.
-    bin: usize,
-    left: Aabb,
-    right: Aabb,
-    n_left: u32,
-    n_right: u32,
-    /// `m(L)` and `m(R)` under the model the split is priced with, kept from the sweep: a
+pub(crate) struct Cut {
+    /// Where it cuts: the first bin of the right side, or the bipartition's mask.
+    pub at: usize,
+    pub left: Aabb,
+    pub right: Aabb,
+    pub n_left: u32,
+    pub n_right: u32,
+    /// `m(L)` and `m(R)` under the model the cut is priced with, kept from the sweep: a
     /// perspective PAH measure costs hundreds of instructions, so it is never taken twice.
-    measure_left: f32,
-    measure_right: f32,
+    pub measure_left: f32,
+    pub measure_right: f32,
     /// `m(L) n_L + m(R) n_R` under that model.
-    weighted: f32,
+    pub weighted: f32,
 }
 
-impl Split {
-    /// The same split priced under `model` instead of the model that found it: both sides in
+impl Cut {
+    /// The same cut priced under `model` instead of the model that found it: both sides in
     /// one 4-wide evaluation.
     #[inline]
-    fn priced_under(self, model: &impl CostModel) -> Split {
+    pub(crate) fn priced_under(self, model: &impl CostModel) -> Cut {
         let (l, r) = (self.left, self.right);
         let m = model.measure4(&Aabb4::from_boxes([l, r, l, r])).to_array();
         let (ml, mr) = (m[0], m[1]);
-        Split {
+        Cut {
             measure_left: ml,
             measure_right: mr,
             weighted: ml * self.n_left as f32 + mr * self.n_right as f32,
@@ -128,12 +129,18 @@ impl Split {
         }
     }
 
-    /// The thesis's cut ratio `(m(L) + m(R)) / m(parent)` under the model that chose the split;
-    /// keeps the two measures.
+    /// The thesis's cut ratio `(m(L) + m(R)) / m(parent)` under the model that chose the cut.
     #[inline]
     fn ratio(&self, parent: f32) -> f32 {
         (self.measure_left + self.measure_right) / parent
     }
+}
+
+/// A node's chosen split: the axis and the cut along it.
+#[derive(Clone, Copy, Debug)]
+struct Split {
+    axis: usize,
+    cut: Cut,
 }
 
 /// Maps a doubled centroid coordinate to its bin along one axis.
@@ -361,7 +368,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             let decided = if deferred {
                 None
             } else {
-                self.split(arena, &task, &task.bounds, &mut stats, clock, binner)
+                self.split(arena, &task, &mut stats, clock, binner)
             };
             match decided {
                 None => stats.leaves += u32::from(!deferred),
@@ -409,12 +416,11 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         &self,
         arena: &mut BuildArena,
         task: &Task,
-        bounds: &Aabb,
         stats: &mut BuildStats,
         clock: &impl Clock,
         binner: &impl NodeBinner,
     ) -> Option<(Child, Child)> {
-        let count = task.count;
+        let (count, bounds) = (task.count, &task.bounds);
         if task.depth >= self.config.max_depth || count <= 1 {
             return None;
         }
@@ -433,35 +439,23 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                 parent,
                 arena,
                 task,
-                bounds,
                 &mut stats.profile,
                 clock,
                 binner,
             )
-            .map(|s| (s, s.weighted / parent))
+            .map(|(s, how)| (s, how, s.cut.weighted / parent))
         } else {
             // No modelled ray reaches this node (a PAH node outside the light window): SAH, the
             // uniform-ray model, still orders its subtree sensibly for every other ray.
             let parent = Sah.measure(bounds);
             (parent > 0.0 && parent.is_finite())
-                .then(|| {
-                    self.choose(
-                        &Sah,
-                        parent,
-                        arena,
-                        task,
-                        bounds,
-                        &mut stats.profile,
-                        clock,
-                        binner,
-                    )
-                })
+                .then(|| self.choose(&Sah, parent, arena, task, &mut stats.profile, clock, binner))
                 .flatten()
-                .map(|s| (s, s.weighted / parent))
+                .map(|(s, how)| (s, how, s.cut.weighted / parent))
         };
         let k = self.config.constants;
         let leaf_cost = k.intersection * count as f32;
-        let Some((best, relative)) = chosen else {
+        let Some((best, how, relative)) = chosen else {
             // No plane separates the centroids.
             if self
                 .termination
@@ -476,7 +470,10 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         if self.termination.prefer_leaf(count, leaf_cost, split_cost) {
             return None;
         }
-        Some(partition(arena, task, &best))
+        Some(match how {
+            Partition::Plane(map) => partition(arena, task, &best, &map),
+            Partition::Mask(mask) => partition_mask(arena, task, &best, mask),
+        })
     }
 
     /// Bins for a node of `count` primitives. Centroid bins adapt to small nodes (`count` bins, at
@@ -490,7 +487,33 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         }
     }
 
-    /// Bins the node along the axes the cut evaluation needs, then applies it with `model`.
+    /// True when a node of `count` primitives prices every bipartition
+    /// ([`BuildConfig::exhaustive_max`]).
+    #[inline]
+    fn exhaustive(&self, count: u32) -> bool {
+        count <= self.config.exhaustive_max
+            && self.config.cut == CutEvaluation::BestOfAxes
+            && self.config.bin_space == BinSpace::Centroids
+    }
+
+    /// The axes a node's cut evaluation sweeps: those the chooser names, its first only, or all
+    /// three (the thesis's fallback needs the longest axis whatever the chooser said).
+    fn swept_axes(&self, order: &AxisOrder) -> [bool; 3] {
+        let mut swept = [false; 3];
+        match self.config.cut {
+            CutEvaluation::BestOfAxes => order.iter().for_each(|(a, _)| swept[a] = true),
+            CutEvaluation::FirstAxis => {
+                if let Some((a, _)) = order.iter().next() {
+                    swept[a] = true;
+                }
+            }
+            CutEvaluation::Thesis(_) => swept = [true; 3],
+        }
+        swept
+    }
+
+    /// Bins the node along the axes the cut evaluation needs, then applies it with `model` (or,
+    /// for a tiny node, prices every bipartition). Returns the split and how to partition by it.
     #[allow(clippy::too_many_arguments)]
     fn choose<M: CostModel>(
         &self,
@@ -498,114 +521,66 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         parent: f32,
         arena: &mut BuildArena,
         task: &Task,
-        bounds: &Aabb,
         profile: &mut PhaseProfile,
         clock: &impl Clock,
         binner: &impl NodeBinner,
-    ) -> Option<Split> {
+    ) -> Option<(Split, Partition)> {
+        let bounds = &task.bounds;
         let t0 = clock.now_ns();
         let order = self.axes.order(bounds);
         profile.choose_ns += clock.now_ns() - t0;
         profile.choose_calls += 1;
-        let first = order.iter().next()?.0;
-        let mut binned = [false; 3];
-        match self.config.cut {
-            CutEvaluation::BestOfAxes => order.iter().for_each(|(a, _)| binned[a] = true),
-            CutEvaluation::FirstAxis => binned[first] = true,
-            // The fallback needs the longest axis whatever the chooser said.
-            CutEvaluation::Thesis(_) => binned = [true; 3],
-        }
-        let nb = self.bins_for(task.count);
-        if task.count == 2 && self.config.bin_space == BinSpace::Centroids {
+        if self.exhaustive(task.count) {
             let t0 = clock.now_ns();
-            let mut axes = order.iter().map(|(a, _)| a).filter(|&a| binned[a]);
-            let split = match self.config.cut {
-                CutEvaluation::BestOfAxes => {
-                    axes.find_map(|a| split_pair(model, arena, task, a, nb))
-                }
-                CutEvaluation::FirstAxis => split_pair(model, arena, task, first, nb),
-                // The thesis's walk, with every separating axis pricing the same split: the
-                // first one before the quality cut-off is the best, and no later one replaces it.
-                CutEvaluation::Thesis(cut) => {
-                    let best = order
-                        .iter()
-                        .enumerate()
-                        .take_while(|&(i, (_, quality))| i == 0 || quality >= cut.quality_threshold)
-                        .find_map(|(_, (a, _))| split_pair(model, arena, task, a, nb));
-                    match best {
-                        Some(b) if b.ratio(parent) <= cut.acceptable_ratio => Some(b),
-                        // Found under SAH, priced under `model` like the sweep's fallback.
-                        _ => split_pair(&Sah, arena, task, bounds.largest_axis(), nb)
-                            .map(|s| s.priced_under(model))
-                            .or(best),
-                    }
-                }
-            };
+            let slots = arena.refs.slots(task.start as usize, task.count as usize);
+            let hint = model.hint(bounds);
+            let found = cheapest_bipartition(slots, &mut arena.subsets, model, hint);
             profile.cost_ns += clock.now_ns() - t0;
             profile.cost_calls += 1;
-            return split;
+            // The axis means nothing to a mask partition.
+            let (cut, mask) = found?;
+            return Some((Split { axis: 0, cut }, Partition::Mask(mask)));
         }
-        let maps = self.bin(arena, task, bounds, binned, nb, binner);
+        let nb = self.bins_for(task.count);
+        let (cut, largest) = (self.config.cut, bounds.largest_axis());
+        if task.count == 2 && self.config.bin_space == BinSpace::Centroids {
+            // Every axis that separates the two centroids prices the same split, and the walk
+            // keeps the first it is offered: once one axis has found it, offering it again for
+            // the later axes changes nothing and saves pricing it again. No binning needed.
+            let t0 = clock.now_ns();
+            let mut found = None;
+            let split = walk(cut, &order, parent, largest, |axis, sah| {
+                if sah {
+                    return split_pair(&Sah, arena, task, axis, nb).map(|c| c.priced_under(model));
+                }
+                found = found.or_else(|| split_pair(model, arena, task, axis, nb));
+                found
+            });
+            profile.cost_ns += clock.now_ns() - t0;
+            profile.cost_calls += 1;
+            return split.and_then(|s| Some((s, Partition::Plane(pair_map(task, s.axis, nb)?))));
+        }
+        let maps = self.bin(arena, task, bounds, self.swept_axes(&order), nb, binner);
         // The bins past `nb` up to a multiple of four are empty (see `bin`).
         let nb = (nb as usize).next_multiple_of(4);
         let BuildArena { bins, sweep, .. } = arena;
         // Every candidate box lies inside the node: what the model can settle for all of them
         // (say, that they are inside the light's window) it settles once here.
         let hint = model.hint(bounds);
-        let mut sweep_axis = |axis: usize, model: &M| {
+        let split = walk(cut, &order, parent, largest, |axis, sah| {
+            maps[axis]?;
             let t0 = clock.now_ns();
-            let split = sweep_axis(&bins[axis][..nb], sweep, axis, maps[axis]?, model, hint);
+            let bins = &bins[axis][..nb];
+            let cut = if sah {
+                sweep_axis(bins, sweep, &Sah, 0).map(|c| c.priced_under(model))
+            } else {
+                sweep_axis(bins, sweep, model, hint)
+            };
             profile.cost_ns += clock.now_ns() - t0;
             profile.cost_calls += 1;
-            split
-        };
-        match self.config.cut {
-            CutEvaluation::BestOfAxes => {
-                let mut best: Option<Split> = None;
-                for (axis, _) in order.iter() {
-                    if let Some(s) = sweep_axis(axis, model) {
-                        if best.is_none_or(|b| s.weighted < b.weighted) {
-                            best = Some(s);
-                        }
-                    }
-                }
-                best
-            }
-            CutEvaluation::FirstAxis => sweep_axis(first, model),
-            CutEvaluation::Thesis(cut) => {
-                // Cut ratios come from the measures each split keeps from its sweep.
-                let mut best: Option<Split> = None;
-                for (i, (axis, quality)) in order.iter().enumerate() {
-                    if i > 0 && quality < cut.quality_threshold {
-                        break;
-                    }
-                    if let Some(s) = sweep_axis(axis, model) {
-                        if best.is_none_or(|b| s.weighted < b.weighted) {
-                            best = Some(s);
-                        }
-                    }
-                    if best.is_some_and(|b| b.ratio(parent) <= cut.excellent_ratio) {
-                        return best;
-                    }
-                }
-                match best {
-                    Some(b) if b.ratio(parent) <= cut.acceptable_ratio => Some(b),
-                    // Not even acceptable: SAH on the longest axis, the thesis's fallback.
-                    _ => {
-                        let axis = bounds.largest_axis();
-                        let t0 = clock.now_ns();
-                        // Found under SAH, priced under `model` like every other candidate.
-                        let fallback = maps[axis].and_then(|m| {
-                            self::sweep_axis(&bins[axis][..nb], sweep, axis, m, &Sah, 0)
-                                .map(|s| s.priced_under(model))
-                        });
-                        profile.cost_ns += clock.now_ns() - t0;
-                        profile.cost_calls += 1;
-                        fallback.or(best)
-                    }
-                }
-            }
-        }
+            cut
+        })?;
+        Some((split, Partition::Plane(maps[split.axis]?)))
     }
 
     /// Bins the node's primitives along the `axes` flagged, in one pass over its slots. Returns
@@ -700,26 +675,77 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
     }
 }
 
+/// How a node's slots are partitioned by its split.
+#[derive(Clone, Copy, Debug)]
+enum Partition {
+    /// By the split's bin boundary along its axis, under this bin map.
+    Plane(BinMap),
+    /// The primitives (by slot, from the node's first) whose bits are set go left.
+    Mask(u32),
+}
+
+/// Applies the cut evaluation `cut` to a node whose chooser ranked the axes `order`.
+/// `sweep(axis, false)` is the cheapest cut along `axis` under the node's model (`None` where
+/// nothing separates the primitives); `sweep(axis, true)` the cheapest under SAH, re-priced under
+/// the node's model: the thesis's fallback. Ties go to the earlier axis.
+fn walk(
+    cut: CutEvaluation,
+    order: &AxisOrder,
+    parent: f32,
+    largest: usize,
+    mut sweep: impl FnMut(usize, bool) -> Option<Cut>,
+) -> Option<Split> {
+    let mut best: Option<Split> = None;
+    let mut consider = |axis: usize, best: &mut Option<Split>| {
+        if let Some(cut) = sweep(axis, false) {
+            if best.is_none_or(|b| cut.weighted < b.cut.weighted) {
+                *best = Some(Split { axis, cut });
+            }
+        }
+    };
+    match cut {
+        CutEvaluation::BestOfAxes => order.iter().for_each(|(a, _)| consider(a, &mut best)),
+        CutEvaluation::FirstAxis => {
+            if let Some((a, _)) = order.iter().next() {
+                consider(a, &mut best);
+            }
+        }
+        CutEvaluation::Thesis(thesis) => {
+            // Cut ratios come from the measures each cut keeps from its sweep.
+            for (i, (axis, quality)) in order.iter().enumerate() {
+                if i > 0 && quality < thesis.quality_threshold {
+                    break;
+                }
+                consider(axis, &mut best);
+                if best.is_some_and(|b| b.cut.ratio(parent) <= thesis.excellent_ratio) {
+                    return best;
+                }
+            }
+            return match best {
+                Some(b) if b.cut.ratio(parent) <= thesis.acceptable_ratio => Some(b),
+                // Not even acceptable: SAH on the longest axis, the thesis's fallback.
+                _ => sweep(largest, true)
+                    .map(|cut| Split { axis: largest, cut })
+                    .or(best),
+            };
+        }
+    }
+    best
+}
+
 /// The cheapest boundary of one binned axis under `model`. A suffix and a prefix pass write the
 /// boxes and counts on both sides of every boundary into SoA scratch lanes; the boundaries are
 /// then priced four at a time with [`CostModel::measure4`]. O(bins), no allocation.
 ///
 /// The usual bin counts get a copy each with the count a constant, so the passes unroll without
 /// bounds checks; most nodes are small, and there this loop overhead was most of the sweep.
-fn sweep_axis<M: CostModel>(
-    bins: &[Bin],
-    sweep: &mut Sweep,
-    axis: usize,
-    map: BinMap,
-    model: &M,
-    hint: u32,
-) -> Option<Split> {
+fn sweep_axis<M: CostModel>(bins: &[Bin], sweep: &mut Sweep, model: &M, hint: u32) -> Option<Cut> {
     match bins.len() {
-        4 => sweep_bins::<M, 4>(bins[..4].try_into().ok()?, sweep, axis, map, model, hint),
-        8 => sweep_bins::<M, 8>(bins[..8].try_into().ok()?, sweep, axis, map, model, hint),
-        12 => sweep_bins::<M, 12>(bins[..12].try_into().ok()?, sweep, axis, map, model, hint),
-        16 => sweep_bins::<M, 16>(bins[..16].try_into().ok()?, sweep, axis, map, model, hint),
-        _ => sweep_any(bins, sweep, axis, map, model, hint),
+        4 => sweep_bins::<M, 4>(bins[..4].try_into().ok()?, sweep, model, hint),
+        8 => sweep_bins::<M, 8>(bins[..8].try_into().ok()?, sweep, model, hint),
+        12 => sweep_bins::<M, 12>(bins[..12].try_into().ok()?, sweep, model, hint),
+        16 => sweep_bins::<M, 16>(bins[..16].try_into().ok()?, sweep, model, hint),
+        _ => sweep_any(bins, sweep, model, hint),
     }
 }
 
@@ -727,23 +753,14 @@ fn sweep_axis<M: CostModel>(
 fn sweep_bins<M: CostModel, const NB: usize>(
     bins: &[Bin; NB],
     sweep: &mut Sweep,
-    axis: usize,
-    map: BinMap,
     model: &M,
     hint: u32,
-) -> Option<Split> {
-    sweep_any(bins, sweep, axis, map, model, hint)
+) -> Option<Cut> {
+    sweep_any(bins, sweep, model, hint)
 }
 
 #[inline(always)]
-fn sweep_any<M: CostModel>(
-    bins: &[Bin],
-    sweep: &mut Sweep,
-    axis: usize,
-    map: BinMap,
-    model: &M,
-    hint: u32,
-) -> Option<Split> {
+fn sweep_any<M: CostModel>(bins: &[Bin], sweep: &mut Sweep, model: &M, hint: u32) -> Option<Cut> {
     let nb = bins.len();
     // Boundary i (1..nb) separates bins[..i] from bins[i..]; lanes past nb - 1 get empty sides.
     let mut acc = Bin::EMPTY;
@@ -794,15 +811,13 @@ fn sweep_any<M: CostModel>(
     if !weighted.is_finite() {
         return None;
     }
-    let bin = at as usize;
-    Some(Split {
-        axis,
-        map,
-        bin,
-        left: sweep.left.bounds(bin),
-        right: sweep.right.bounds(bin),
-        n_left: sweep.left.count[bin],
-        n_right: sweep.right.count[bin],
+    let at = at as usize;
+    Some(Cut {
+        at,
+        left: sweep.left.bounds(at),
+        right: sweep.right.bounds(at),
+        n_left: sweep.left.count[at],
+        n_right: sweep.right.count[at],
         measure_left: best_ml.to_array()[won],
         measure_right: best_mr.to_array()[won],
         weighted,
@@ -824,7 +839,7 @@ fn split_pair<M: CostModel>(
     task: &Task,
     axis: usize,
     nb: u32,
-) -> Option<Split> {
+) -> Option<Cut> {
     let map = pair_map(task, axis, nb)?;
     let s = task.start as usize;
     let (mut left, mut right) = (s, s + 1);
@@ -842,10 +857,8 @@ fn split_pair<M: CostModel>(
     let m = model
         .measure4(&Aabb4::from_boxes([left, right, right, right]))
         .to_array();
-    Some(Split {
-        axis,
-        map,
-        bin: bin_left + 1,
+    Some(Cut {
+        at: bin_left + 1,
         left,
         right,
         n_left: 1,
@@ -871,14 +884,28 @@ fn ceil_log2(n: u32) -> u32 {
 
 /// Partitions the node's slots in place by the split's bin boundary. The child boxes come from
 /// the bins; the children's centroid bounds are gathered as each slot is classified.
-fn partition(arena: &mut BuildArena, task: &Task, split: &Split) -> (Child, Child) {
+fn partition(arena: &mut BuildArena, task: &Task, split: &Split, map: &BinMap) -> (Child, Child) {
     // Finding the threshold costs a few dozen bin evaluations: small nodes classify by bin.
+    let at = split.cut.at;
     if task.count <= THRESHOLD_MIN_COUNT {
-        partition_by(arena, task, split, |c| split.map.bin(c) < split.bin)
+        partition_by(arena, task, split, |c| map.bin(c) < at)
     } else {
-        let threshold = split.map.threshold(split.bin);
+        let threshold = map.threshold(at);
         partition_by(arena, task, split, |c| c < threshold)
     }
+}
+
+/// Partitions a node of at most [`super::MAX_EXHAUSTIVE`] slots by the mask of its exhaustive split.
+fn partition_mask(arena: &mut BuildArena, task: &Task, split: &Split, mask: u32) -> (Child, Child) {
+    let slots = arena
+        .refs
+        .slots_mut(task.start as usize, task.count as usize);
+    let [(l_lo, l_hi), (r_lo, r_hi)] = partition_by_mask(slots, mask);
+    let cut = &split.cut;
+    (
+        (cut.left, cut.n_left, lanes_to_aabb(l_lo, l_hi)),
+        (cut.right, cut.n_right, lanes_to_aabb(r_lo, r_hi)),
+    )
 }
 
 /// Nodes of at least this size are binned into two sets of bins, even and odd slots apart, then
@@ -931,10 +958,11 @@ fn partition_by(
         (r_lo, r_hi) = (r_lo.fast_min(cr), r_hi.fast_max(cr));
         i += 1;
     }
-    debug_assert_eq!(i as u32 - task.start, split.n_left);
+    let cut = &split.cut;
+    debug_assert_eq!(i as u32 - task.start, cut.n_left);
     (
-        (split.left, split.n_left, lanes_to_aabb(l_lo, l_hi)),
-        (split.right, split.n_right, lanes_to_aabb(r_lo, r_hi)),
+        (cut.left, cut.n_left, lanes_to_aabb(l_lo, l_hi)),
+        (cut.right, cut.n_right, lanes_to_aabb(r_lo, r_hi)),
     )
 }
 

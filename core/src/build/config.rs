@@ -7,6 +7,10 @@ use crate::BuildError;
 /// The most bins a sweep may use; bins live in fixed arrays, so this bounds the arena's size.
 pub const MAX_BINS: u32 = 64;
 
+/// The most primitives [`BuildConfig::exhaustive_max`] may name: a node of six has 31
+/// bipartitions, about what three sweeps of sixteen bins price.
+pub const MAX_EXHAUSTIVE: u32 = 6;
+
 /// Where the candidate planes of a node lie.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BinSpace {
@@ -71,6 +75,13 @@ pub struct BuildConfig {
     pub cut: CutEvaluation,
     /// Where the candidate planes lie.
     pub bin_space: BinSpace,
+    /// Nodes of at most this many primitives (0 to [`MAX_EXHAUSTIVE`]) price every bipartition
+    /// of their primitives instead of binning: the cheapest split of all, at a fraction of a
+    /// binned node's fixed costs, which dominate the many tiny nodes near the leaves. Only with
+    /// [`CutEvaluation::BestOfAxes`] (the other evaluations are about which axes a node tries)
+    /// and [`BinSpace::Centroids`] (node-box planes reproduce the thesis's builder). 0 bins every
+    /// node.
+    pub exhaustive_max: u32,
 }
 
 impl Default for BuildConfig {
@@ -81,6 +92,7 @@ impl Default for BuildConfig {
             max_depth: MAX_DEPTH,
             cut: CutEvaluation::BestOfAxes,
             bin_space: BinSpace::Centroids,
+            exhaustive_max: 4,
         }
     }
 }
@@ -90,6 +102,11 @@ impl BuildConfig {
     pub fn validate(&self) -> Result<(), BuildError> {
         if !(2..=MAX_BINS).contains(&self.bins) {
             return Err(BuildError::InvalidConfig("bins must be between 2 and 64"));
+        }
+        if self.exhaustive_max > MAX_EXHAUSTIVE {
+            return Err(BuildError::InvalidConfig(
+                "exhaustive_max must be at most 6",
+            ));
         }
         if !(1..=MAX_DEPTH).contains(&self.max_depth) {
             return Err(BuildError::InvalidConfig(

@@ -158,6 +158,7 @@ impl PresetOptions {
                 BinSpace::Centroids
             },
             max_depth: self.max_depth.min(MAX_DEPTH),
+            ..BuildConfig::default()
         }
     }
 }

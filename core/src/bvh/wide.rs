@@ -94,8 +94,9 @@ impl WideBvh {
     /// Collapses a binary BVH built over `tris`: each wide node takes a binary node's children and
     /// keeps opening the inner child of largest surface area (the one a ray is likeliest to enter)
     /// until it has four. A binary subtree of at most four triangles becomes one leaf of one
-    /// [`Triangle4`] block, one of five to eight a leaf of two blocks when [`MERGE_RATIO`] says
-    /// splitting it saves little, and a larger binary leaf a leaf of consecutive blocks. Depth
+    /// [`Triangle4`] block, one of five to eight a leaf of two blocks when the merge ratio
+    /// (`MERGE_RATIO`, 0.5) says splitting it saves little, and a larger binary leaf a leaf of
+    /// consecutive blocks. Depth
     /// never grows. Ids missing from `tris` are dropped, as the binary traversal skips them.
     pub fn from_binary(bvh: &Bvh, tris: &[Triangle]) -> Self {
         let mut out = WideBvh {

@@ -96,8 +96,7 @@ impl WideBvh {
     /// until it has four. A binary subtree of at most four triangles becomes one leaf of one
     /// [`Triangle4`] block, one of five to eight a leaf of two blocks when the merge ratio
     /// (`MERGE_RATIO`, 0.5) says splitting it saves little, and a larger binary leaf a leaf of
-    /// consecutive blocks. Depth
-    /// never grows. Ids missing from `tris` are dropped, as the binary traversal skips them.
+    /// consecutive blocks. Depth never grows. Ids missing from `tris` are dropped, as the binary traversal skips them.
     pub fn from_binary(bvh: &Bvh, tris: &[Triangle]) -> Self {
         let mut out = WideBvh {
             nodes: Vec::with_capacity(bvh.nodes.len() / 4 + 1),

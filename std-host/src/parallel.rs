@@ -1,10 +1,10 @@
 //! Threaded builds with rayon: the same trees as the single-threaded core builder, sooner.
 //!
 //! A binary build is split where subtrees get small: the core builds the top of the tree on one
-//! thread and hands back the nodes of at most `cutoff` primitives as jobs
-//! ([`Builder::build_top`]); rayon builds the jobs on all threads, each over its own arena at its
-//! own depth ([`Builder::build_subtree_into`]); [`Bvh::graft`] splices them in and re-lays the
-//! nodes out in the single-threaded order. The result is the single-threaded tree node for node,
+//! thread and hands over each node of at most `cutoff` primitives as a job the moment it reaches
+//! it ([`Builder::build_top_into`]); rayon builds the jobs on all threads while the top goes on,
+//! each over its own arena at its own depth ([`Builder::build_subtree_into`]); [`Bvh::graft`]
+//! splices them in and re-lays the nodes out in the single-threaded order. The result is the single-threaded tree node for node,
 //! which the tests check. Scenes build their local BVHs and the fallback BVH concurrently.
 //!
 //! The serial part is kept small: the triangle bounds are loaded in parallel parts
@@ -14,9 +14,11 @@
 
 use rayon::prelude::*;
 
+use std::sync::Mutex;
+
 use rdbvh_core::build::{
     BinJob, BuildArena, Builder, LoadedBounds, NodeBinner, NodeBins, PresetError, Subtree,
-    TriangleLoad,
+    SubtreeSink, TriangleLoad,
 };
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
@@ -105,36 +107,66 @@ where
 {
     let mut top = Bvh::with_capacity(arena.len());
     let mut jobs = Vec::new();
-    builder.build_top_with(
-        arena,
-        &mut top,
-        cutoff(arena.len()),
-        &mut jobs,
-        &ParallelBinner,
-    )?;
-    let arena = &*arena;
-    let subtrees = jobs
-        .par_iter()
-        .map(|job| build_job(builder, arena, job))
+    let built = Mutex::new(Vec::new());
+    let cutoff = cutoff(arena.len());
+    let top_built = rayon::scope(|scope| {
+        let mut sink = Spawner {
+            scope,
+            builder,
+            jobs: &mut jobs,
+            built: &built,
+        };
+        builder.build_top_into(arena, &mut top, cutoff, &mut sink, &ParallelBinner)
+    });
+    top_built?;
+    // A job that panicked has already re-raised its panic through the scope.
+    let mut built = built.into_inner().unwrap_or_else(|e| e.into_inner());
+    built.sort_unstable_by_key(|(index, _)| *index);
+    let subtrees = built
+        .into_iter()
+        .map(|(_, subtree)| subtree)
         .collect::<Result<Vec<Bvh>, BuildError>>()?;
     Bvh::graft(top, &jobs, &subtrees).map_err(|_| BuildError::InvalidConfig("graft mismatch"))
 }
 
-fn build_job<A, C, T>(
-    builder: &Builder<A, C, T>,
-    arena: &BuildArena,
-    job: &Subtree,
-) -> Result<Bvh, BuildError>
+/// A subtree built by a job, by its index among the jobs.
+type Built = (usize, Result<Bvh, BuildError>);
+
+/// Starts each subtree's build as soon as the top leaves it: its primitives are copied into an
+/// arena of its own on the top's thread (the top never touches those slots again), and the build
+/// runs on any thread while the top goes on, so the top's serial partitions overlap the subtree
+/// builds instead of preceding them all.
+struct Spawner<'scope, 'env, A, C, T> {
+    scope: &'env rayon::Scope<'scope>,
+    builder: &'scope Builder<A, C, T>,
+    jobs: &'env mut Vec<Subtree>,
+    built: &'scope Mutex<Vec<Built>>,
+}
+
+impl<A, C, T> SubtreeSink for Spawner<'_, '_, A, C, T>
 where
-    A: AxisChooser,
-    C: CostModel,
-    T: Termination,
+    A: AxisChooser + Sync,
+    C: CostModel + Sync,
+    T: Termination + Sync,
 {
-    let mut local = BuildArena::with_capacity(job.count as usize);
-    local.load_slots(arena, job.start as usize..(job.start + job.count) as usize)?;
-    let mut out = Bvh::with_capacity(job.count as usize);
-    builder.build_subtree_into(&mut local, &mut out, job.depth)?;
-    Ok(out)
+    fn take(&mut self, job: Subtree, arena: &BuildArena) {
+        let index = self.jobs.len();
+        self.jobs.push(job);
+        let mut local = BuildArena::with_capacity(job.count as usize);
+        let loaded = local.load_slots(arena, job.start as usize..(job.start + job.count) as usize);
+        let (builder, built) = (self.builder, self.built);
+        self.scope.spawn(move |_| {
+            let subtree = loaded.and_then(|()| {
+                let mut out = Bvh::with_capacity(job.count as usize);
+                builder.build_subtree_into(&mut local, &mut out, job.depth)?;
+                Ok(out)
+            });
+            built
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push((index, subtree));
+        });
+    }
 }
 
 /// Builds a [`Scene`] with its local BVHs and its fallback BVH on all threads; equal to

@@ -31,6 +31,23 @@ pub struct Subtree {
     pub depth: u32,
 }
 
+/// Takes the subtrees [`Builder::build_top_into`] leaves, in the order the single-threaded build
+/// would reach them, each with the arena holding its primitives (slots `start..start + count`).
+pub trait SubtreeSink {
+    /// Takes one subtree.
+    fn take(&mut self, job: Subtree, arena: &BuildArena);
+}
+
+/// Records the subtrees, to build once the top is done.
+impl SubtreeSink for Vec<Subtree> {
+    fn take(&mut self, job: Subtree, _arena: &BuildArena) {
+        self.push(job);
+    }
+}
+
+/// No subtrees left for later: every node is built.
+const NO_JOBS: Option<&mut Vec<Subtree>> = None;
+
 /// What a build produced, besides the BVH.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct BuildStats {
@@ -264,7 +281,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         arena: &mut BuildArena,
         out: &mut Bvh,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, 0, 0, None, &NoClock, &SerialBinner)
+        self.build_range(arena, out, 0, 0, NO_JOBS, &NoClock, &SerialBinner)
     }
 
     /// [`Builder::build_into`], timing its phases with `clock` into [`BuildStats::profile`].
@@ -274,7 +291,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         out: &mut Bvh,
         clock: &impl Clock,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, 0, 0, None, clock, &SerialBinner)
+        self.build_range(arena, out, 0, 0, NO_JOBS, clock, &SerialBinner)
     }
 
     /// [`Builder::build_into`] for a subtree whose root sits at depth `depth` of a larger tree, so
@@ -286,7 +303,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         out: &mut Bvh,
         depth: u32,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, depth, 0, None, &NoClock, &SerialBinner)
+        self.build_range(arena, out, depth, 0, NO_JOBS, &NoClock, &SerialBinner)
     }
 
     /// The top of a build, for threaded builders: like [`Builder::build_into`], but a node of at
@@ -315,7 +332,22 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         binner: &impl NodeBinner,
     ) -> Result<BuildStats, BuildError> {
         jobs.clear();
-        self.build_range(arena, out, 0, cutoff, Some(jobs), &NoClock, binner)
+        self.build_top_into(arena, out, cutoff, jobs, binner)
+    }
+
+    /// [`Builder::build_top_with`] handing each subtree to `sink` the moment the top leaves it,
+    /// with the arena its primitives are in: a threaded host copies them out and starts building
+    /// the subtree while the top goes on, so the top's partitions no longer run alone. The top
+    /// never touches a handed-over subtree's slots again.
+    pub fn build_top_into(
+        &self,
+        arena: &mut BuildArena,
+        out: &mut Bvh,
+        cutoff: u32,
+        sink: &mut impl SubtreeSink,
+        binner: &impl NodeBinner,
+    ) -> Result<BuildStats, BuildError> {
+        self.build_range(arena, out, 0, cutoff, Some(sink), &NoClock, binner)
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -325,7 +357,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         out: &mut Bvh,
         depth: u32,
         cutoff: u32,
-        mut jobs: Option<&mut Vec<Subtree>>,
+        mut jobs: Option<&mut impl SubtreeSink>,
         clock: &impl Clock,
         binner: &impl NodeBinner,
     ) -> Result<BuildStats, BuildError> {
@@ -355,12 +387,13 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             stats.max_depth = stats.max_depth.max(task.depth);
             let deferred = match jobs.as_deref_mut() {
                 Some(jobs) if task.count <= cutoff => {
-                    jobs.push(Subtree {
+                    let job = Subtree {
                         node: task.node,
                         start: task.start,
                         count: task.count,
                         depth: task.depth,
-                    });
+                    };
+                    jobs.take(job, arena);
                     true
                 }
                 _ => false,

@@ -16,7 +16,7 @@ mod profile;
 
 pub use arena::{BuildArena, LoadedBounds, TriangleLoad};
 pub use binning::{BinJob, NodeBinner, NodeBins, SerialBinner};
-pub use builder::{BuildStats, Builder, Subtree};
+pub use builder::{BuildStats, Builder, Subtree, SubtreeSink};
 pub use config::{BinSpace, BuildConfig, CutEvaluation, ThesisCut, MAX_BINS, MAX_EXHAUSTIVE};
 pub use graft::GraftError;
 pub use preset::{AreaPah, Preset, PresetError, PresetOptions};

@@ -49,6 +49,18 @@ impl PrimRef {
         f32x4::from(self.hi)
     }
 
+    /// Twice the centroid along `axis` only.
+    #[inline(always)]
+    pub fn centroid2_axis(&self, axis: usize) -> f32 {
+        self.lo[axis] + self.hi[axis]
+    }
+
+    /// Twice the centroid as a lane; lane 3 holds garbage (the id's bits) and must be ignored.
+    #[inline(always)]
+    pub fn centroid2_4(&self) -> f32x4 {
+        self.lo4() + self.hi4()
+    }
+
     /// The primitive id.
     #[inline(always)]
     pub fn id(&self) -> u32 {
@@ -89,6 +101,12 @@ impl PrimRefs {
         &self.refs[start..start + count]
     }
 
+    /// Slots `start..start + count`, mutable.
+    #[inline(always)]
+    pub fn slots_mut(&mut self, start: usize, count: usize) -> &mut [PrimRef] {
+        &mut self.refs[start..start + count]
+    }
+
     /// The ids in slot order.
     pub fn ids(&self) -> impl Iterator<Item = u32> + '_ {
         self.refs.iter().map(PrimRef::id)
@@ -97,8 +115,7 @@ impl PrimRefs {
     /// Twice the centroid of slot `i` along `axis` only.
     #[inline(always)]
     pub fn centroid2_axis(&self, i: usize, axis: usize) -> f32 {
-        let r = &self.refs[i];
-        r.lo[axis] + r.hi[axis]
+        self.refs[i].centroid2_axis(axis)
     }
 
     /// The bounds of slot `i`.

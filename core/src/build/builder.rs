@@ -1,6 +1,6 @@
 //! The build skeleton: choose axes, bin, sweep, then stop or split. Heuristics are type parameters.
 
-use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRefs, Sweep, Task};
+use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRef, PrimRefs, Sweep, Task};
 use super::binning::{BinJob, NodeBinner, SerialBinner};
 use super::config::{BinSpace, BuildConfig, CutEvaluation, MAX_BINS};
 use super::profile::{Clock, NoClock, PhaseProfile};
@@ -890,6 +890,11 @@ const DUAL_BINNING_MIN: usize = 256;
 const THRESHOLD_MIN_COUNT: u32 = 16;
 
 /// [`partition`] with the classification `goes_left` of a doubled centroid coordinate.
+///
+/// Hoare's scheme over the shrinking slice of unclassified slots: only misplaced pairs are
+/// swapped, and slice patterns give the two ends of the slice without index bounds checks. The
+/// child centroid bounds are gathered in 4-wide lanes as each slot settles on its side (lane 3
+/// carries id bits and is dropped).
 #[inline(always)]
 fn partition_by(
     arena: &mut BuildArena,
@@ -897,41 +902,48 @@ fn partition_by(
     split: &Split,
     goes_left: impl Fn(f32) -> bool,
 ) -> (Child, Child) {
-    let refs = &mut arena.refs;
     let axis = split.axis;
-    let goes_left = |refs: &PrimRefs, i: usize| goes_left(refs.centroid2_axis(i, axis));
-    // Hoare's scheme: only misplaced pairs are swapped. The child centroid bounds are gathered in
-    // 4-wide lanes as each slot settles on its side (lane 3 carries id bits and is dropped).
+    let goes_left = |r: &PrimRef| goes_left(r.centroid2_axis(axis));
     let inf = f32x4::splat(f32::INFINITY);
     let (mut l_lo, mut l_hi, mut r_lo, mut r_hi) = (inf, -inf, inf, -inf);
-    let c2 = |refs: &PrimRefs, i: usize| {
-        let r = refs.get(i);
-        r.lo4() + r.hi4()
-    };
-    let (mut i, mut j) = (task.start as usize, (task.start + task.count) as usize);
+    let mut rest = arena
+        .refs
+        .slots_mut(task.start as usize, task.count as usize);
+    let base = rest.as_ptr() as usize;
     loop {
-        while i < j && goes_left(refs, i) {
-            let c = c2(refs, i);
+        // Slots already on the left, from the front.
+        let mut k = 0;
+        while k < rest.len() && goes_left(&rest[k]) {
+            let c = rest[k].centroid2_4();
             (l_lo, l_hi) = (l_lo.fast_min(c), l_hi.fast_max(c));
-            i += 1;
+            k += 1;
         }
-        while i < j && !goes_left(refs, j - 1) {
-            j -= 1;
-            let c = c2(refs, j);
+        rest = &mut core::mem::take(&mut rest)[k..];
+        // Slots already on the right, from the back.
+        let mut m = rest.len();
+        while m > 0 && !goes_left(&rest[m - 1]) {
+            m -= 1;
+            let c = rest[m].centroid2_4();
             (r_lo, r_hi) = (r_lo.fast_min(c), r_hi.fast_max(c));
         }
-        if i >= j {
+        rest = &mut core::mem::take(&mut rest)[..m];
+        // The first slot belongs right and the last left (one slot cannot be both): swap them.
+        let unsorted = core::mem::take(&mut rest);
+        let [first, middle @ .., last] = unsorted else {
+            rest = unsorted;
             break;
-        }
-        // Slot i belongs right and slot j - 1 left: swap them into place.
-        j -= 1;
-        refs.swap(i, j);
-        let (cl, cr) = (c2(refs, i), c2(refs, j));
+        };
+        core::mem::swap(first, last);
+        let (cl, cr) = (first.centroid2_4(), last.centroid2_4());
         (l_lo, l_hi) = (l_lo.fast_min(cl), l_hi.fast_max(cl));
         (r_lo, r_hi) = (r_lo.fast_min(cr), r_hi.fast_max(cr));
-        i += 1;
+        rest = middle;
     }
-    debug_assert_eq!(i as u32 - task.start, split.n_left);
+    // The empty rest sits at the boundary between the children.
+    debug_assert_eq!(
+        (rest.as_ptr() as usize - base) / core::mem::size_of::<PrimRef>(),
+        split.n_left as usize
+    );
     (
         (split.left, split.n_left, lanes_to_aabb(l_lo, l_hi)),
         (split.right, split.n_right, lanes_to_aabb(r_lo, r_hi)),

@@ -136,7 +136,11 @@ impl PrimRefs {
 
 /// One bin of a sweep: how many centroids fell in it and the bounds of their primitives, kept as
 /// 4-wide lanes `(x, y, z, 0)` so growing it by a primitive is one `minps` and one `maxps`.
+///
+/// Padded to 64 bytes: the binning loop addresses a bin by its index shifted left by 6, one
+/// instruction per axis where 48 bytes took two (see [`super::binning::BinOffsets`]).
 #[derive(Clone, Copy, Debug)]
+#[repr(align(64))]
 pub(crate) struct Bin {
     pub min: f32x4,
     pub max: f32x4,

@@ -2,7 +2,7 @@
 
 use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRef, PrimRefs, Sweep, Task};
 use super::binning::{BinJob, NodeBinner, SerialBinner};
-use super::config::{BinSpace, BuildConfig, CutEvaluation, MAX_BINS};
+use super::config::{BinSpace, BuildConfig, CutEvaluation};
 use super::profile::{Clock, NoClock, PhaseProfile};
 use crate::bvh::{Bvh, BvhNode};
 use alloc::vec::Vec;
@@ -683,15 +683,10 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             let bins = [bx, by, bz];
             for r in slots {
                 let (lo, hi) = (r.lo4(), r.hi4());
-                let i = ((lo + hi - min) * scale)
-                    .fast_max(f32x4::ZERO)
-                    .fast_min(last)
-                    .fast_trunc_int()
-                    .to_array()
-                    .map(|i| i as usize & (MAX_BINS as usize - 1));
+                let at = job.offsets(lo, hi);
                 for axis in 0..3 {
                     if active[axis] {
-                        bins[axis][i[axis]].grow(lo, hi);
+                        at.bin(bins[axis], axis).grow(lo, hi);
                     }
                 }
             }

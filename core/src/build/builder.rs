@@ -654,12 +654,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         let (min, scale, last) = (lane(|m| m.min), lane(|m| m.scale), lane(|m| m.last));
         let active = [maps[0].is_some(), maps[1].is_some(), maps[2].is_some()];
         let slots = arena.refs.slots(task.start as usize, task.count as usize);
-        let job = BinJob {
-            refs: slots,
-            min,
-            scale,
-            last,
-        };
+        let job = BinJob::new(slots, min, scale, last);
         if let Some(parts) = binner.bin(&job) {
             arena.bins = parts.bins;
         } else if active == [true; 3] {
@@ -1186,6 +1181,42 @@ mod tests {
                     let c = lo + rng.range(0.0, 1.0) * (hi - lo);
                     assert_eq!(c < t, map.bin(c) < bin, "{map:?} bin {bin} c {c} t {t}");
                 }
+            }
+        }
+    }
+
+    /// The binning pass computes byte offsets from byte-scaled maps; they must be exactly the
+    /// bin size times `BinMap::bin`, which the partition's threshold reproduces.
+    #[test]
+    fn bin_offsets_match_the_bin_map() {
+        let mut rng = crate::random::Pcg32::new(17);
+        let bin_bytes = core::mem::size_of::<Bin>() as u32;
+        for round in 0..3000 {
+            let offset = [0.0, 1e3, -1e5, 3e7, 1e30][round % 5];
+            let lo = offset + rng.range(-10.0, 10.0);
+            let hi = [lo + rng.range(1e-4, 20.0), lo + 1e-30, f32::MAX][round % 3];
+            let nb = 2 + (round as u32 % 63);
+            let Some(map) = BinMap::new(lo, hi, nb) else {
+                continue;
+            };
+            let job = BinJob::new(
+                &[],
+                f32x4::splat(map.min),
+                f32x4::splat(map.scale),
+                f32x4::splat(map.last),
+            );
+            for k in 0..40 {
+                let c = match k {
+                    0 => lo,
+                    1 => hi,
+                    2 => map.threshold(1 + round % (nb as usize - 1)),
+                    3 => map.threshold(1 + round % (nb as usize - 1)).next_down(),
+                    _ => lo + rng.range(0.0, 1.0) * (hi - lo),
+                };
+                // The centroid is `lo + hi` of the box: pass it as `lo` with a zero `hi`.
+                let at = job.offsets(f32x4::splat(c), f32x4::ZERO);
+                let expect = map.bin(c) as u32 * bin_bytes;
+                assert_eq!(at.lanes()[0], expect, "{map:?} c {c}");
             }
         }
     }

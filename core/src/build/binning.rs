@@ -165,7 +165,9 @@ impl BinOffsets {
     #[inline(always)]
     pub(crate) fn bin(self, bins: &mut [Bin; MAX_BINS as usize], axis: usize) -> &mut Bin {
         let off = self.0[axis] as usize;
-        debug_assert!(off < core::mem::size_of_val(bins) && off % core::mem::size_of::<Bin>() == 0);
+        debug_assert!(
+            off < core::mem::size_of_val(bins) && off.is_multiple_of(core::mem::size_of::<Bin>())
+        );
         // SAFETY: `new`'s mask made every lane `k * size_of::<Bin>()` with `k < MAX_BINS`, so `off` is
         // the offset of element `k` of `bins`: in bounds and aligned, and the exclusive borrow of
         // `bins` covers the returned one.

@@ -56,6 +56,18 @@ impl PrimRef {
         f32x4::from(self.hi)
     }
 
+    /// Twice the centroid along `axis` only.
+    #[inline(always)]
+    pub fn centroid2_axis(&self, axis: usize) -> f32 {
+        self.lo[axis] + self.hi[axis]
+    }
+
+    /// Twice the centroid as a lane; lane 3 holds garbage (the id's bits) and must be ignored.
+    #[inline(always)]
+    pub fn centroid2_4(&self) -> f32x4 {
+        self.lo4() + self.hi4()
+    }
+
     /// The primitive id.
     #[inline(always)]
     pub fn id(&self) -> u32 {
@@ -110,8 +122,7 @@ impl PrimRefs {
     /// Twice the centroid of slot `i` along `axis` only.
     #[inline(always)]
     pub fn centroid2_axis(&self, i: usize, axis: usize) -> f32 {
-        let r = &self.refs[i];
-        r.lo[axis] + r.hi[axis]
+        self.refs[i].centroid2_axis(axis)
     }
 
     /// The bounds of slot `i`.
@@ -132,7 +143,11 @@ impl PrimRefs {
 
 /// One bin of a sweep: how many centroids fell in it and the bounds of their primitives, kept as
 /// 4-wide lanes `(x, y, z, 0)` so growing it by a primitive is one `minps` and one `maxps`.
+///
+/// Padded to 64 bytes: the binning loop addresses a bin by its index shifted left by 6, one
+/// instruction per axis where 48 bytes took two (see [`super::binning::BinOffsets`]).
 #[derive(Clone, Copy, Debug)]
+#[repr(align(64))]
 pub(crate) struct Bin {
     pub min: f32x4,
     pub max: f32x4,

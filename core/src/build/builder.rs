@@ -1,8 +1,8 @@
 //! The build skeleton: choose axes, bin, sweep, then stop or split. Heuristics are type parameters.
 
-use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRefs, Sweep, Task};
+use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRef, PrimRefs, Sweep, Task};
 use super::binning::{BinJob, NodeBinner, SerialBinner};
-use super::config::{BinSpace, BuildConfig, CutEvaluation, MAX_BINS};
+use super::config::{BinSpace, BuildConfig, CutEvaluation};
 use super::exhaustive::{cheapest_bipartition, partition_by_mask};
 use super::profile::{Clock, NoClock, PhaseProfile};
 use crate::bvh::{Bvh, BvhNode};
@@ -662,12 +662,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         let (min, scale, last) = (lane(|m| m.min), lane(|m| m.scale), lane(|m| m.last));
         let active = [maps[0].is_some(), maps[1].is_some(), maps[2].is_some()];
         let slots = arena.refs.slots(task.start as usize, task.count as usize);
-        let job = BinJob {
-            refs: slots,
-            min,
-            scale,
-            last,
-        };
+        let job = BinJob::new(slots, min, scale, last);
         if let Some(parts) = binner.bin(&job) {
             arena.bins = parts.bins;
         } else if active == [true; 3] {
@@ -691,15 +686,10 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             let bins = [bx, by, bz];
             for r in slots {
                 let (lo, hi) = (r.lo4(), r.hi4());
-                let i = ((lo + hi - min) * scale)
-                    .fast_max(f32x4::ZERO)
-                    .fast_min(last)
-                    .fast_trunc_int()
-                    .to_array()
-                    .map(|i| i as usize & (MAX_BINS as usize - 1));
+                let at = job.offsets(lo, hi);
                 for axis in 0..3 {
                     if active[axis] {
-                        bins[axis][i[axis]].grow(lo, hi);
+                        at.bin(bins[axis], axis).grow(lo, hi);
                     }
                 }
             }
@@ -950,6 +940,11 @@ const DUAL_BINNING_MIN: usize = 256;
 const THRESHOLD_MIN_COUNT: u32 = 16;
 
 /// [`partition`] with the classification `goes_left` of a doubled centroid coordinate.
+///
+/// Hoare's scheme over the shrinking slice of unclassified slots: only misplaced pairs are
+/// swapped, and slice patterns give the two ends of the slice without index bounds checks. The
+/// child centroid bounds are gathered in 4-wide lanes as each slot settles on its side (lane 3
+/// carries id bits and is dropped).
 #[inline(always)]
 fn partition_by(
     arena: &mut BuildArena,
@@ -957,42 +952,49 @@ fn partition_by(
     split: &Split,
     goes_left: impl Fn(f32) -> bool,
 ) -> (Child, Child) {
-    let refs = &mut arena.refs;
     let axis = split.axis;
-    let goes_left = |refs: &PrimRefs, i: usize| goes_left(refs.centroid2_axis(i, axis));
-    // Hoare's scheme: only misplaced pairs are swapped. The child centroid bounds are gathered in
-    // 4-wide lanes as each slot settles on its side (lane 3 carries id bits and is dropped).
+    let goes_left = |r: &PrimRef| goes_left(r.centroid2_axis(axis));
     let inf = f32x4::splat(f32::INFINITY);
     let (mut l_lo, mut l_hi, mut r_lo, mut r_hi) = (inf, -inf, inf, -inf);
-    let c2 = |refs: &PrimRefs, i: usize| {
-        let r = refs.get(i);
-        r.lo4() + r.hi4()
-    };
-    let (mut i, mut j) = (task.start as usize, (task.start + task.count) as usize);
+    let mut rest = arena
+        .refs
+        .slots_mut(task.start as usize, task.count as usize);
+    let base = rest.as_ptr() as usize;
     loop {
-        while i < j && goes_left(refs, i) {
-            let c = c2(refs, i);
+        // Slots already on the left, from the front.
+        let mut k = 0;
+        while k < rest.len() && goes_left(&rest[k]) {
+            let c = rest[k].centroid2_4();
             (l_lo, l_hi) = (l_lo.fast_min(c), l_hi.fast_max(c));
-            i += 1;
+            k += 1;
         }
-        while i < j && !goes_left(refs, j - 1) {
-            j -= 1;
-            let c = c2(refs, j);
+        rest = &mut core::mem::take(&mut rest)[k..];
+        // Slots already on the right, from the back.
+        let mut m = rest.len();
+        while m > 0 && !goes_left(&rest[m - 1]) {
+            m -= 1;
+            let c = rest[m].centroid2_4();
             (r_lo, r_hi) = (r_lo.fast_min(c), r_hi.fast_max(c));
         }
-        if i >= j {
+        rest = &mut core::mem::take(&mut rest)[..m];
+        // The first slot belongs right and the last left (one slot cannot be both): swap them.
+        let unsorted = core::mem::take(&mut rest);
+        let [first, middle @ .., last] = unsorted else {
+            rest = unsorted;
             break;
-        }
-        // Slot i belongs right and slot j - 1 left: swap them into place.
-        j -= 1;
-        refs.swap(i, j);
-        let (cl, cr) = (c2(refs, i), c2(refs, j));
+        };
+        core::mem::swap(first, last);
+        let (cl, cr) = (first.centroid2_4(), last.centroid2_4());
         (l_lo, l_hi) = (l_lo.fast_min(cl), l_hi.fast_max(cl));
         (r_lo, r_hi) = (r_lo.fast_min(cr), r_hi.fast_max(cr));
-        i += 1;
+        rest = middle;
     }
     let cut = &split.cut;
-    debug_assert_eq!(i as u32 - task.start, cut.n_left);
+    // The empty rest sits at the boundary between the children.
+    debug_assert_eq!(
+        (rest.as_ptr() as usize - base) / core::mem::size_of::<PrimRef>(),
+        cut.n_left as usize
+    );
     (
         (cut.left, cut.n_left, lanes_to_aabb(l_lo, l_hi)),
         (cut.right, cut.n_right, lanes_to_aabb(r_lo, r_hi)),
@@ -1240,6 +1242,42 @@ mod tests {
                     let c = lo + rng.range(0.0, 1.0) * (hi - lo);
                     assert_eq!(c < t, map.bin(c) < bin, "{map:?} bin {bin} c {c} t {t}");
                 }
+            }
+        }
+    }
+
+    /// The binning pass computes byte offsets from byte-scaled maps; they must be exactly the
+    /// bin size times `BinMap::bin`, which the partition's threshold reproduces.
+    #[test]
+    fn bin_offsets_match_the_bin_map() {
+        let mut rng = crate::random::Pcg32::new(17);
+        let bin_bytes = core::mem::size_of::<Bin>() as u32;
+        for round in 0..3000 {
+            let offset = [0.0, 1e3, -1e5, 3e7, 1e30][round % 5];
+            let lo = offset + rng.range(-10.0, 10.0);
+            let hi = [lo + rng.range(1e-4, 20.0), lo + 1e-30, f32::MAX][round % 3];
+            let nb = 2 + (round as u32 % 63);
+            let Some(map) = BinMap::new(lo, hi, nb) else {
+                continue;
+            };
+            let job = BinJob::new(
+                &[],
+                f32x4::splat(map.min),
+                f32x4::splat(map.scale),
+                f32x4::splat(map.last),
+            );
+            for k in 0..40 {
+                let c = match k {
+                    0 => lo,
+                    1 => hi,
+                    2 => map.threshold(1 + round % (nb as usize - 1)),
+                    3 => map.threshold(1 + round % (nb as usize - 1)).next_down(),
+                    _ => lo + rng.range(0.0, 1.0) * (hi - lo),
+                };
+                // The centroid is `lo + hi` of the box: pass it as `lo` with a zero `hi`.
+                let at = job.offsets(f32x4::splat(c), f32x4::ZERO);
+                let expect = map.bin(c) as u32 * bin_bytes;
+                assert_eq!(at.lanes()[0], expect, "{map:?} c {c}");
             }
         }
     }

@@ -10,6 +10,13 @@
 //! cheapest of all, so never more expensive than the best binned split (each of those is one of
 //! these bipartitions). Ties go to the most balanced, then the lowest mask, so the tree is a
 //! function of the input alone.
+//!
+//! The default is three primitives (every pair node a SAH build prices, and the three-primitive
+//! nodes). callgrind on the bunny's SAH build: 175.3M instructions with 0 (bins and the pair
+//! shortcut), 164.6M with three or four, 166.0M with five; Sponza 699.3M, 667.7M with three,
+//! 673.2M with four. Thread time matches the builder before this module (whose pair shortcut took
+//! a cheaper route through the cut evaluation than the shared walk now does): the gain is the
+//! optimal split at no cost, not speed.
 
 use super::arena::{lanes_to_aabb, soa, Bin, PrimRef};
 use super::builder::Cut;

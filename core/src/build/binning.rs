@@ -43,7 +43,7 @@ pub struct BinJob<'a> {
 }
 
 /// The size of a [`Bin`] as a float: a power of two, so scaling by it is exact.
-const BIN_BYTES: f32 = {
+pub(crate) const BIN_BYTES: f32 = {
     assert!(core::mem::size_of::<Bin>().is_power_of_two());
     core::mem::size_of::<Bin>() as f32
 };

@@ -1,7 +1,7 @@
 //! The build skeleton: choose axes, bin, sweep, then stop or split. Heuristics are type parameters.
 
 use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRef, PrimRefs, Sweep, Task};
-use super::binning::{BinJob, NodeBinner, SerialBinner};
+use super::binning::{BinJob, NodeBinner, SerialBinner, BIN_BYTES};
 use super::config::{BinSpace, BuildConfig, CutEvaluation};
 use super::exhaustive::{cheapest_bipartition, partition_by_mask};
 use super::profile::{Clock, NoClock, PhaseProfile};
@@ -175,7 +175,11 @@ impl BinMap {
         let extent = max - min;
         // The scale is shrunk by a few ulps so the largest centroid maps inside the last bin.
         let scale = bins as f32 * (1.0 - 4.0 * f32::EPSILON) / extent;
-        (extent > 0.0 && scale.is_finite()).then_some(Self {
+        // The binning pass multiplies the scale by the bin size (`BinJob`): that product must
+        // stay finite too, or it would put every centroid above `min` in the last bin while the
+        // partition classifies by this scale. Only centroid extents below 2e-37 per bin have no
+        // map (no plane then separates them, as for coincident centroids).
+        (extent > 0.0 && (scale * BIN_BYTES).is_finite()).then_some(Self {
             min,
             scale,
             last: (bins - 1) as f32,
@@ -1256,6 +1260,17 @@ mod tests {
             let offset = [0.0, 1e3, -1e5, 3e7, 1e30][round % 5];
             let lo = offset + rng.range(-10.0, 10.0);
             let hi = [lo + rng.range(1e-4, 20.0), lo + 1e-30, f32::MAX][round % 3];
+            // Every seventh round, a range near the smallest normal floats, where the scale is
+            // finite but the byte-scaled one would overflow. Found by `build_query` (kept in
+            // `fuzz/regressions/build_query/`): the binning put a subnormal centroid in the last
+            // bin and the partition in the first, so a child's count and box disagreed with
+            // its slots (the partition's debug assertion caught it).
+            let (lo, hi) = if round % 7 == 6 {
+                let lo = [0.0, 1e-38, -2e-38, 1e-40][round % 4];
+                (lo, lo + [1e-36, 1e-37, 2.35e-38, 1e-39][(round / 7) % 4])
+            } else {
+                (lo, hi)
+            };
             let nb = 2 + (round as u32 % 63);
             let Some(map) = BinMap::new(lo, hi, nb) else {
                 continue;

@@ -948,7 +948,7 @@ const THRESHOLD_MIN_COUNT: u32 = 16;
 /// Hoare's scheme over the shrinking slice of unclassified slots: only misplaced pairs are
 /// swapped, and slice patterns give the two ends of the slice without index bounds checks. The
 /// child centroid bounds are gathered in 4-wide lanes as each slot settles on its side (lane 3
-/// carries id bits and is dropped).
+/// carries the id's halves and is dropped).
 #[inline(always)]
 fn partition_by(
     arena: &mut BuildArena,

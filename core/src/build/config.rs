@@ -92,7 +92,7 @@ impl Default for BuildConfig {
             max_depth: MAX_DEPTH,
             cut: CutEvaluation::BestOfAxes,
             bin_space: BinSpace::Centroids,
-            exhaustive_max: 3,
+            exhaustive_max: 4,
         }
     }
 }

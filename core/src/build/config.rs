@@ -67,7 +67,7 @@ pub enum CutEvaluation {
 pub struct BuildConfig {
     /// Centroid bins per axis, 2 to [`MAX_BINS`]; each bin boundary is a candidate plane. With
     /// [`BinSpace::Centroids`], a node of fewer than `2 * bins` primitives uses half as many bins
-    /// as it has primitives, at least 4.
+    /// as it has primitives, at least 4 (and never more than `bins`).
     pub bins: u32,
     /// The cost constants used to price splits against leaves.
     pub constants: CostConstants,

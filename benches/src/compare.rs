@@ -285,12 +285,33 @@ fn load_average() -> String {
 }
 
 /// One adapter between its checks and its timings: a scene to build from, its tree built once
-/// for the traversals, and the rays in its own format.
+/// for the traversals, the rays in its own format, and how its one-thread and threaded trees
+/// agreed with rdbvh.
 struct Contender<L: Library> {
     build: L::Scene,
     prepared: Prepared<L>,
     camera: Vec<L::Ray>,
     random: Vec<L::Ray>,
+    agreement: [Agreement; 2],
+    agreement_mt: [Agreement; 2],
+}
+
+impl<L: Library> Contender<L> {
+    /// Its timings (in [`Measure::ALL`] order) as its [`LibraryRun`]: a library without a
+    /// threaded build reports its one-thread build as `build_mt`.
+    fn run(&self, t: &[Timing]) -> LibraryRun {
+        let build_mt = match L::PARALLEL_BUILD {
+            Some(_) => t[1],
+            None => t[0],
+        };
+        LibraryRun {
+            name: L::NAME,
+            parallel_build: L::PARALLEL_BUILD,
+            timings: [t[0], build_mt, t[2], t[3], t[4]],
+            agreement: self.agreement,
+            agreement_mt: self.agreement_mt,
+        }
+    }
 }
 
 impl<L: Library> Reps for Contender<L>
@@ -325,16 +346,14 @@ where
     }
 }
 
-/// An adapter's trees (threaded and one-thread) checked against `sets`' reference answers,
-/// ready to be timed, and the agreements found.
-type Checked<L> = (Contender<L>, [Agreement; 2], [Agreement; 2]);
-
+/// An adapter's trees (threaded and one-thread) checked against `sets`' reference answers, and
+/// the adapter ready to be timed.
 fn check<L: Library>(
     tris: &[Triangle],
     sets: &[(RayKind, Vec<Ray>, Answers)],
     one: &rayon::ThreadPool,
     all: &rayon::ThreadPool,
-) -> Result<Checked<L>, String>
+) -> Result<Contender<L>, String>
 where
     L::Scene: Send,
     L::Accel: Send,
@@ -375,33 +394,14 @@ where
         let set = sets.iter().find(|(k, _, _)| *k == kind).expect("ray set");
         L::rays(&set.1)
     };
-    let contender = Contender {
+    Ok(Contender {
         build: L::scene(tris),
         prepared,
         camera: native(RayKind::Camera),
         random: native(RayKind::Random),
-    };
-    Ok((contender, agreement_1t, agreement_mt))
-}
-
-/// A contender's timings as its [`LibraryRun`]: a library without a threaded build reports its
-/// one-thread build as `build_mt`.
-fn library_run<L: Library>(
-    agreement: [Agreement; 2],
-    agreement_mt: [Agreement; 2],
-    t: &[Timing],
-) -> LibraryRun {
-    let build_mt = match L::PARALLEL_BUILD {
-        Some(_) => t[1],
-        None => t[0],
-    };
-    LibraryRun {
-        name: L::NAME,
-        parallel_build: L::PARALLEL_BUILD,
-        timings: [t[0], build_mt, t[2], t[3], t[4]],
-        agreement,
+        agreement: agreement_1t,
         agreement_mt,
-    }
+    })
 }
 
 /// A plane area over `b`: a light rectangle on top of the box (largest y), rays straight down,
@@ -484,7 +484,8 @@ impl Reps for PahReps<'_> {
         one: &rayon::ThreadPool,
         _: &rayon::ThreadPool,
     ) -> Option<(f64, f64)> {
-        one.install(|| time(|| self.build(k).is_ok())).into()
+        // Built once untimed in `new`: a timed build does not fail.
+        Some(one.install(|| time(|| self.build(k).is_ok())))
     }
 }
 
@@ -518,12 +519,12 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         a.closest.iter().filter(|t| t.is_some()).count() as f64 / a.closest.len().max(1) as f64
     };
     // Every tree checked first, then every number measured in interleaved rounds.
-    let (mut rdbvh, a0, m0) = check::<Rdbvh>(tris, &sets, &one, &all)?;
-    let (mut wide, a1, m1) = check::<RdbvhWide>(tris, &sets, &one, &all)?;
-    let (mut bvh2, a2, m2) = check::<ObvhsBvh2>(tris, &sets, &one, &all)?;
-    let (mut cwbvh, a3, m3) = check::<ObvhsCwbvh>(tris, &sets, &one, &all)?;
-    let (mut bvh, a4, m4) = check::<BvhCrate>(tris, &sets, &one, &all)?;
-    let (mut parry, a5, m5) = check::<Parry>(tris, &sets, &one, &all)?;
+    let mut rdbvh = check::<Rdbvh>(tris, &sets, &one, &all)?;
+    let mut wide = check::<RdbvhWide>(tris, &sets, &one, &all)?;
+    let mut bvh2 = check::<ObvhsBvh2>(tris, &sets, &one, &all)?;
+    let mut cwbvh = check::<ObvhsCwbvh>(tris, &sets, &one, &all)?;
+    let mut bvh = check::<BvhCrate>(tris, &sets, &one, &all)?;
+    let mut parry = check::<Parry>(tris, &sets, &one, &all)?;
     let mut top = SerialTop::new(tris, all.current_num_threads());
     let mut pah_reps = if opts.pah {
         Some(PahReps::new(tris, &b)?)
@@ -538,12 +539,12 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
     }
     let t = interleave(&mut entries, opts, &one, &all);
     let runs = vec![
-        library_run::<Rdbvh>(a0, m0, &t[0]),
-        library_run::<RdbvhWide>(a1, m1, &t[1]),
-        library_run::<ObvhsBvh2>(a2, m2, &t[2]),
-        library_run::<ObvhsCwbvh>(a3, m3, &t[3]),
-        library_run::<BvhCrate>(a4, m4, &t[4]),
-        library_run::<Parry>(a5, m5, &t[5]),
+        rdbvh.run(&t[0]),
+        wide.run(&t[1]),
+        bvh2.run(&t[2]),
+        cwbvh.run(&t[3]),
+        bvh.run(&t[4]),
+        parry.run(&t[5]),
     ];
     let serial_top = (t[6][0], t[6][1]);
     let pah = t.get(7).map(|p| PahBuilds {

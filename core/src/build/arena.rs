@@ -39,7 +39,7 @@ pub(crate) struct PrimRef {
 
 /// The bits of `1.0f32`: lane 3 of a [`PrimRef`] corner is `ID_LANE_ONE | (16 id bits)`, a
 /// normal float in `[1, 2)` whatever the id.
-pub(crate) const ID_LANE_ONE: u32 = 0x3f80_0000;
+const ID_LANE_ONE: u32 = 0x3f80_0000;
 
 impl PrimRef {
     /// All zero: the filler of fixed scratch arrays.

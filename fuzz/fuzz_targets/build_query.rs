@@ -1,12 +1,13 @@
-//! Build with every preset and both builders over arbitrary triangles, then check the tree
-//! invariants and every traversal (binary and 4-wide) against brute force.
+//! Build with every preset and both builders over arbitrary triangles, and reinsert each tree,
+//! then check the tree invariants and every traversal (binary and 4-wide) against brute force.
 #![no_main]
 
 use arbitrary::{Result, Unstructured};
 use libfuzzer_sys::fuzz_target;
-use rdbvh_core::build::{BuildArena, Builder, Preset};
+use rdbvh_core::build::{reinsert, BuildArena, Builder, Preset, ReinsertConfig};
 use rdbvh_core::bvh::{Bvh, WideBvh, MAX_DEPTH};
 use rdbvh_core::geometry::{Ray, Triangle};
+use rdbvh_core::heuristics::{CostConstants, Sah};
 use rdbvh_core::influence::{InfluenceArea, PlaneArea};
 use rdbvh_core::Vec3;
 use rdbvh_fuzz::*;
@@ -65,6 +66,31 @@ fn run(u: &mut Unstructured) -> Result<()> {
             built.push((format!("{preset} {options:?}"), bvh, MAX_DEPTH));
         }
     }
+
+    // Every tree again after reinsertion (every node tried, within the tree's own depth bound):
+    // the same invariants, the same answers, never a higher SAH cost.
+    let fraction = if u.arbitrary::<bool>()? { 1.0 } else { 0.1 };
+    let reinserted: Vec<(String, Bvh, u32)> = built
+        .iter()
+        .map(|(what, bvh, max_depth)| {
+            let mut better = bvh.clone();
+            let config = ReinsertConfig {
+                fraction,
+                max_passes: 2,
+                max_depth: *max_depth,
+                ..ReinsertConfig::default()
+            };
+            reinsert(&mut better, &Sah, &config);
+            let k = CostConstants::default();
+            let (before, after) = (bvh.estimated_cost(&Sah, k), better.estimated_cost(&Sah, k));
+            assert!(
+                !(after > before * (1.0 + 1e-5)),
+                "{what}: reinsertion raised the SAH cost {before} -> {after}"
+            );
+            (format!("{what} reinserted"), better, *max_depth)
+        })
+        .collect();
+    built.extend(reinserted);
 
     for (what, bvh, max_depth) in &built {
         check_tree(bvh, &tris, *max_depth, what);

@@ -1,6 +1,7 @@
 //! Whole pipeline on the real scenes of `../shared/scenes/`: load with the host's OBJ loader, check
-//! the load against `MANIFEST.tsv`, build with SAH and LSPH, validate, and trace deterministic
-//! camera-like and interior rays, comparing every answer with the brute-force oracle.
+//! the load against `MANIFEST.tsv`, build with SAH and LSPH (and the SAH tree reinserted), validate,
+//! and trace deterministic camera-like and interior rays, comparing every answer with the
+//! brute-force oracle.
 //!
 //! Brute force costs rays x triangles, so big scenes compare a deterministic subset of their rays
 //! with the oracle (about `ORACLE_BUDGET` triangle tests per scene) and check the rest for
@@ -11,9 +12,10 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use rdbvh::scene::Scene;
-use rdbvh_core::build::{BuildArena, Builder};
+use rdbvh_core::build::{reinsert, BuildArena, Builder, ReinsertConfig};
 use rdbvh_core::bvh::{Bvh, WideBvh};
 use rdbvh_core::geometry::{Ray, Triangle};
+use rdbvh_core::heuristics::{CostConstants, Sah};
 use rdbvh_tests::{
     camera_rays, check_ray_against, check_ray_consistency, check_structure, check_wide_ray,
     check_wide_structure, interior_rays, require_scene, require_shared, scene_bounds, Oracle,
@@ -97,7 +99,19 @@ fn run_scene(relative: &str, rays_per_kind: usize) -> Option<Report> {
     let mut again = Bvh::with_capacity(tris.len());
     Builder::sah().build_into(&mut arena, &mut again).unwrap();
     assert_eq!(again, sah, "{relative}: build and build_into differ");
-    for bvh in [&sah, &lsph] {
+    // The SAH tree improved by reinsertion: same leaves, never a higher SAH cost.
+    let mut reinserted = sah.clone();
+    reinsert(&mut reinserted, &Sah, &ReinsertConfig::default());
+    let k = CostConstants::default();
+    let (before, after) = (
+        sah.estimated_cost(&Sah, k),
+        reinserted.estimated_cost(&Sah, k),
+    );
+    assert!(
+        after <= before * (1.0 + 1e-6),
+        "{relative}: reinsertion raised the SAH cost {before} -> {after}"
+    );
+    for bvh in [&sah, &lsph, &reinserted] {
         check_structure(bvh, tris);
         assert!(
             bvh.nodes().len() > 1 || tris.len() <= 8,
@@ -126,7 +140,7 @@ fn run_scene(relative: &str, rays_per_kind: usize) -> Option<Report> {
     for (i, ray) in rays.iter().enumerate() {
         if i % stride == 0 {
             let oracle = Oracle::new(ray, tris);
-            for bvh in [&sah, &lsph] {
+            for bvh in [&sah, &lsph, &reinserted] {
                 check_ray_against(bvh, tris, ray, &oracle);
             }
             check_wide_ray(&wide, tris, ray, oracle.closest);
@@ -135,8 +149,13 @@ fn run_scene(relative: &str, rays_per_kind: usize) -> Option<Report> {
         } else {
             let a = check_ray_consistency(&sah, tris, ray);
             let b = check_ray_consistency(&lsph, tris, ray);
-            // Two valid BVHs over the same triangles give the same exact closest hit.
+            let c = check_ray_consistency(&reinserted, tris, ray);
+            // Valid BVHs over the same triangles give the same exact closest hit.
             assert_eq!(a, b, "{relative}: SAH and LSPH disagree for {ray:?}");
+            assert_eq!(
+                a, c,
+                "{relative}: SAH before and after reinsertion disagree for {ray:?}"
+            );
             check_wide_ray(&wide, tris, ray, a);
         }
     }

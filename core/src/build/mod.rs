@@ -13,6 +13,7 @@ mod exhaustive;
 mod graft;
 mod preset;
 mod profile;
+mod reinsert;
 
 pub use arena::{BuildArena, LoadedBounds, TriangleLoad};
 pub use binning::{BinJob, NodeBinner, NodeBins, SerialBinner};
@@ -21,3 +22,4 @@ pub use config::{BinSpace, BuildConfig, CutEvaluation, ThesisCut, MAX_BINS, MAX_
 pub use graft::GraftError;
 pub use preset::{AreaPah, Preset, PresetError, PresetOptions};
 pub use profile::{Clock, NoClock, PhaseProfile};
+pub use reinsert::{reinsert, ReinsertConfig, ReinsertStats, Reinserter};

@@ -81,6 +81,28 @@ fn build_json_has_the_contract_keys() {
 }
 
 #[test]
+fn build_reinsert_reports_and_never_costs_more() {
+    let plain = json_of(&rdbvh(&["build", "builtin:random1000", "--json"]));
+    let better = json_of(&rdbvh(&[
+        "build",
+        "builtin:random1000",
+        "--json",
+        "--reinsert",
+    ]));
+    assert!(plain["reinsert_ms"].is_null() && plain["reinsert_moved"].is_null());
+    assert!(better["reinsert_ms"].as_f64().unwrap() >= 0.0, "{better}");
+    assert!(better["reinsert_moved"].as_u64().is_some(), "{better}");
+    let cost = |j: &serde_json::Value| j["sah_cost"].as_f64().unwrap();
+    assert!(
+        cost(&better) <= cost(&plain) * (1.0 + 1e-6),
+        "{plain} vs {better}"
+    );
+    assert_eq!(better["nodes"], plain["nodes"]);
+    let table = text(&rdbvh(&["build", "builtin:room", "--reinsert"]).stdout);
+    assert!(table.contains("reinsert "), "{table}");
+}
+
+#[test]
 fn build_table_and_builders() {
     let sah = rdbvh(&["build", "builtin:room"]);
     let lsph = rdbvh(&["build", "builtin:room", "--builder", "lsph", "--bins", "8"]);
@@ -269,7 +291,8 @@ fn assert_answers(
     hits
 }
 
-/// Runs `trace` on `scene_arg` both ways and compares every answer with brute force, exactly.
+/// Runs `trace` on `scene_arg` for closest and any hit, on the built tree and on the reinserted
+/// one, and compares every answer with brute force, exactly.
 fn check_trace(scene_arg: &str, rays_count: usize) {
     let scene = Scene::open(scene_arg).unwrap();
     let rays = random_rays(&scene, rays_count, 7);
@@ -277,7 +300,7 @@ fn check_trace(scene_arg: &str, rays_count: usize) {
     let rays_csv = dir.join("rays.csv");
     let rays = write_rays(&rays_csv, &rays);
 
-    for any_hit in [false, true] {
+    for (any_hit, reinsert) in [(false, false), (true, false), (false, true), (true, true)] {
         let hits_csv = dir.join(if any_hit { "any.csv" } else { "closest.csv" });
         let mut args = vec![
             "trace",
@@ -289,6 +312,9 @@ fn check_trace(scene_arg: &str, rays_count: usize) {
         ];
         if any_hit {
             args.push("--any-hit");
+        }
+        if reinsert {
+            args.push("--reinsert");
         }
         let out = rdbvh(&args);
         assert!(out.status.success(), "{}", text(&out.stderr));
@@ -464,6 +490,19 @@ fn build_with_areas_reports_the_area_build() {
     );
     let pah = full["pah_cost"].as_f64().unwrap();
     assert!(pah > 0.0 && pah.is_finite(), "{full}");
+    // Reinsertion of a PAH preset's tree moves nodes under the area's PAH: never a higher cost.
+    let reinserted = json_of(&rdbvh(&[
+        "build",
+        "builtin:room",
+        "--preset",
+        "full",
+        "--areas",
+        areas,
+        "--reinsert",
+        "--json",
+    ]));
+    let after = reinserted["pah_cost"].as_f64().unwrap();
+    assert!(after <= pah * (1.0 + 1e-6), "{full} vs {reinserted}");
 
     // Every preset and the plain builders build the same subset.
     for (flag, name) in [
@@ -727,6 +766,15 @@ fn area_and_option_errors_are_one_line() {
             },
             2,
             vec!["--builder", "--preset"],
+        ),
+        (
+            {
+                let mut a = trace(&good);
+                a.push("--reinsert".into());
+                a
+            },
+            2,
+            vec!["--reinsert", "--areas"],
         ),
         (
             {

@@ -63,6 +63,10 @@ pub struct BuildReport {
     pub select_ms: Option<f64>,
     /// Milliseconds of the build alone.
     pub build_ms: f64,
+    /// With `--reinsert`: milliseconds of the reinsertion after the build (not in `build_ms`).
+    pub reinsert_ms: Option<f64>,
+    /// With `--reinsert`: how many nodes reinsertion moved.
+    pub reinsert_moved: Option<u32>,
     /// Millions of triangles built per second.
     pub mtris_per_s: f64,
     /// The split-axis chooser: `sah` (all three axes), `lsph` (longest) or `spfh` (facing).
@@ -130,6 +134,8 @@ pub fn run(args: &BuildArgs, out: &mut impl Write) -> Result<(), CliError> {
         load_ms: load_seconds * 1e3,
         select_ms: select_seconds.map(|s| s * 1e3),
         build_ms: built.seconds * 1e3,
+        reinsert_ms: built.reinsert.map(|(_, s)| s * 1e3),
+        reinsert_moved: built.reinsert.map(|(r, _)| r.moved),
         mtris_per_s: built.mtris_per_s(triangles),
         builder: args.builder.chooser_name(),
         preset: args.builder.preset().map(|p| p.name()),
@@ -189,5 +195,8 @@ fn table(r: &BuildReport) -> String {
         "build time  {:.3} ms ({:.2} Mtris/s)",
         r.build_ms, r.mtris_per_s
     );
+    if let (Some(ms), Some(moved)) = (r.reinsert_ms, r.reinsert_moved) {
+        s += &format!("\nreinsert    {ms:.3} ms ({moved} nodes moved)");
+    }
     s
 }

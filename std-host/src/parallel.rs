@@ -3,9 +3,10 @@
 //! A binary build is split where subtrees get small: the core builds the top of the tree on one
 //! thread and hands over each node of at most `cutoff` primitives as a job the moment it reaches
 //! it ([`Builder::build_top_into`]); rayon builds the jobs on all threads while the top goes on,
-//! each over its own arena at its own depth ([`Builder::build_subtree_into`]); [`Bvh::graft`]
-//! splices them in and re-lays the nodes out in the single-threaded order. The result is the single-threaded tree node for node,
-//! which the tests check. Scenes build their local BVHs and the fallback BVH concurrently.
+//! each over its own arena at its own depth and with its root's measure as the top priced it
+//! ([`Builder::build_subtree_into`]); [`Bvh::graft`] splices them in and re-lays the nodes out in
+//! the single-threaded order. The result is the single-threaded tree node for node, which the
+//! tests check. Scenes build their local BVHs and the fallback BVH concurrently.
 //!
 //! The serial part is kept small: the triangle bounds are loaded in parallel parts
 //! ([`BuildArena::load_triangles_with`]), and the top nodes, each a pass over many primitives,
@@ -158,7 +159,7 @@ where
         self.scope.spawn(move |_| {
             let subtree = loaded.and_then(|()| {
                 let mut out = Bvh::with_capacity(job.count as usize);
-                builder.build_subtree_into(&mut local, &mut out, job.depth)?;
+                builder.build_subtree_into(&mut local, &mut out, &job)?;
                 Ok(out)
             });
             built
@@ -226,6 +227,8 @@ pub fn build_scene<L: AreaLookup>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rdbvh_core::build::BuildConfig;
+    use rdbvh_core::heuristics::{AllAxes, PahPerspective, PerspectiveMeasure, SahTermination};
     use rdbvh_core::influence::{PlaneArea, PointArea};
     use rdbvh_core::random::Pcg32;
     use rdbvh_core::toplevel::Octree;
@@ -250,6 +253,34 @@ mod tests {
         let lsph = Builder::lsph();
         assert_eq!(build(&lsph, &tris).unwrap(), lsph.build(&tris).unwrap());
         assert_eq!(build(&lsph, &[]).unwrap(), lsph.build(&[]).unwrap());
+    }
+
+    #[test]
+    fn threaded_perspective_pah_build_equals_single_threaded() {
+        // The jobs' roots take the measures the top's splits priced them with, as the
+        // single-threaded build does (the perspective measure's 4-wide and scalar paths need not
+        // agree to the bit; `graft`'s tests check that a job's measure is used).
+        let tris = soup(40_000);
+        for (eye, fov) in [
+            (Vec3::new(0.0, 14.0, 0.0), 80.0),
+            (Vec3::new(0.0, 11.0, 0.0), 120.0),
+            (Vec3::new(1.0, 2.0, 0.5), 150.0),
+        ] {
+            let area = PointArea::new(eye, -Vec3::Y, fov, fov, 0.1, 30.0).unwrap();
+            for measure in [
+                PerspectiveMeasure::SolidAngle,
+                PerspectiveMeasure::ImagePlane,
+            ] {
+                let pah = PahPerspective::for_area(&area, measure);
+                let config = BuildConfig::default();
+                let b = Builder::new(AllAxes, pah, SahTermination::default(), config);
+                assert_eq!(
+                    build(&b, &tris).unwrap(),
+                    b.build(&tris).unwrap(),
+                    "{eye} {fov}"
+                );
+            }
+        }
     }
 
     #[test]

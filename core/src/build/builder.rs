@@ -19,7 +19,7 @@ use crate::BuildError;
 
 /// A subtree left for a separate build by [`Builder::build_top`]: the placeholder leaf `node`
 /// over primitive slots `start..start + count`, at depth `depth`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Subtree {
     /// The placeholder node.
     pub node: u32,
@@ -29,6 +29,12 @@ pub struct Subtree {
     pub count: u32,
     /// Depth of the subtree's root in the whole tree.
     pub depth: u32,
+    /// The root's measure under the builder's cost model, as its parent's split priced it (`None`
+    /// where the split did not price it under that model). A node's split is priced relative to
+    /// its own measure, and the whole build takes it from the parent's sweep rather than
+    /// measuring again (a perspective PAH measure costs hundreds of instructions); a subtree
+    /// built with the same value is exactly the whole build's.
+    pub measure: Option<f32>,
 }
 
 /// Takes the subtrees [`Builder::build_top_into`] leaves, in the order the single-threaded build
@@ -285,7 +291,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         arena: &mut BuildArena,
         out: &mut Bvh,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, 0, 0, NO_JOBS, &NoClock, &SerialBinner)
+        self.build_range(arena, out, (0, None), 0, NO_JOBS, &NoClock, &SerialBinner)
     }
 
     /// [`Builder::build_into`], timing its phases with `clock` into [`BuildStats::profile`].
@@ -295,19 +301,21 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         out: &mut Bvh,
         clock: &impl Clock,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, 0, 0, NO_JOBS, clock, &SerialBinner)
+        self.build_range(arena, out, (0, None), 0, NO_JOBS, clock, &SerialBinner)
     }
 
-    /// [`Builder::build_into`] for a subtree whose root sits at depth `depth` of a larger tree, so
-    /// the depth bound and every depth-dependent decision are those of the whole build: the result
-    /// is exactly the subtree the whole build would make from these primitives.
+    /// [`Builder::build_into`] for the subtree `job` of a larger build (the arena loaded with its
+    /// primitives): its root sits at the job's depth, so the depth bound and every depth-dependent
+    /// decision are those of the whole build, and takes the job's measure, so the result is
+    /// exactly the subtree the whole build would make from these primitives.
     pub fn build_subtree_into(
         &self,
         arena: &mut BuildArena,
         out: &mut Bvh,
-        depth: u32,
+        job: &Subtree,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, depth, 0, NO_JOBS, &NoClock, &SerialBinner)
+        let root = (job.depth, job.measure);
+        self.build_range(arena, out, root, 0, NO_JOBS, &NoClock, &SerialBinner)
     }
 
     /// The top of a build, for threaded builders: like [`Builder::build_into`], but a node of at
@@ -351,15 +359,16 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         sink: &mut impl SubtreeSink,
         binner: &impl NodeBinner,
     ) -> Result<BuildStats, BuildError> {
-        self.build_range(arena, out, 0, cutoff, Some(sink), &NoClock, binner)
+        self.build_range(arena, out, (0, None), cutoff, Some(sink), &NoClock, binner)
     }
 
     #[allow(clippy::too_many_arguments)]
+    /// The build loop from a root at `root.0`'s depth with `root.1`'s known measure.
     fn build_range(
         &self,
         arena: &mut BuildArena,
         out: &mut Bvh,
-        depth: u32,
+        (depth, measure): (u32, Option<f32>),
         cutoff: u32,
         mut jobs: Option<&mut impl SubtreeSink>,
         clock: &impl Clock,
@@ -386,6 +395,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             count: n as u32,
             depth,
             centroids: arena.centroids,
+            measure: measure.unwrap_or(f32::NAN),
         };
         loop {
             stats.max_depth = stats.max_depth.max(task.depth);
@@ -396,6 +406,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                         start: task.start,
                         count: task.count,
                         depth: task.depth,
+                        measure: (!task.measure.is_nan()).then_some(task.measure),
                     };
                     jobs.take(job, arena);
                     true
@@ -409,7 +420,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             };
             match decided {
                 None => stats.leaves += u32::from(!deferred),
-                Some((left, right)) => {
+                Some((left, right, measures)) => {
                     let l = out.nodes.len() as u32;
                     out.nodes[task.node as usize].left_first = l;
                     out.nodes[task.node as usize].count = 0;
@@ -424,6 +435,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                         count: right.1,
                         depth,
                         centroids: right.2,
+                        measure: measures[1],
                     });
                     task = Task {
                         node: l,
@@ -432,6 +444,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                         count: left.1,
                         depth,
                         centroids: left.2,
+                        measure: measures[0],
                     };
                     continue;
                 }
@@ -448,7 +461,8 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
     }
 
     /// Decides one node: `None` for a leaf, or the two children after partitioning the node's
-    /// slots in place.
+    /// slots in place, with their measures under the builder's model when the split priced them
+    /// under it (NaN otherwise).
     fn split(
         &self,
         arena: &mut BuildArena,
@@ -456,7 +470,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         stats: &mut BuildStats,
         clock: &impl Clock,
         binner: &impl NodeBinner,
-    ) -> Option<(Child, Child)> {
+    ) -> Option<(Child, Child, [f32; 2])> {
         let (count, bounds) = (task.count, &task.bounds);
         if task.depth >= self.config.max_depth || count <= 1 {
             return None;
@@ -467,10 +481,16 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         // The depth budget: a node that could not finish with halving splits alone takes them now.
         if task.depth + ceil_log2(count) >= self.config.max_depth {
             stats.median_splits += 1;
-            return Some(median_split(&mut arena.refs, task));
+            let (l, r) = median_split(&mut arena.refs, task);
+            return Some((l, r, [f32::NAN; 2]));
         }
-        let parent = self.cost.measure(bounds);
-        let chosen = if parent > 0.0 && parent.is_finite() {
+        let parent = if task.measure.is_nan() {
+            self.cost.measure(bounds)
+        } else {
+            task.measure
+        };
+        let modelled = parent > 0.0 && parent.is_finite();
+        let chosen = if modelled {
             self.choose(
                 &self.cost,
                 parent,
@@ -501,16 +521,25 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                 return None;
             }
             stats.median_splits += 1;
-            return Some(median_split(&mut arena.refs, task));
+            let (l, r) = median_split(&mut arena.refs, task);
+            return Some((l, r, [f32::NAN; 2]));
         };
         let split_cost = k.traversal + k.intersection * relative;
         if self.termination.prefer_leaf(count, leaf_cost, split_cost) {
             return None;
         }
-        Some(match how {
+        let (l, r) = match how {
             Partition::Plane(map) => partition(arena, task, &best, &map),
             Partition::Mask(mask) => partition_mask(arena, task, &best, mask),
-        })
+        };
+        // The children's boxes are the cut's, so its measures are theirs; under the SAH stand-in
+        // they are SAH's, not the model's, and the children measure themselves (NaN).
+        let measures = if modelled {
+            [best.cut.measure_left, best.cut.measure_right]
+        } else {
+            [f32::NAN; 2]
+        };
+        Some((l, r, measures))
     }
 
     /// Bins for a node of `count` primitives. Centroid bins adapt to small nodes (`count / 2`

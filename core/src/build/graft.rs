@@ -31,8 +31,8 @@ impl core::error::Error for GraftError {}
 
 impl Bvh {
     /// Replaces each job's placeholder leaf in `top` (from [`super::Builder::build_top`]) with the
-    /// subtree built for it (with [`super::Builder::build_subtree_into`] over the job's slots, in
-    /// slot order), then lays the nodes out in the order the single-threaded builder allocates
+    /// subtree built for it (with [`super::Builder::build_subtree_into`] for the job, over its
+    /// slots in slot order), then lays the nodes out in the order the single-threaded builder allocates
     /// them, so the result equals `build_into`'s tree node for node.
     pub fn graft(top: Bvh, jobs: &[Subtree], subtrees: &[Bvh]) -> Result<Bvh, GraftError> {
         if jobs.len() != subtrees.len() {
@@ -143,17 +143,25 @@ fn canonical_layout(
 mod tests {
     use alloc::vec::Vec;
 
-    use super::*;
-    use crate::build::{BuildArena, Builder};
+    use glam::Vec3;
 
-    #[test]
-    fn grafted_tree_equals_single_threaded_tree() {
-        let tris = crate::test_scenes::soup(3000, 8, -10.0, 10.0, 0.5);
-        let builder = Builder::sah();
-        let whole = builder.build(&tris).unwrap();
+    use super::*;
+    use crate::build::{BuildArena, BuildConfig, Builder};
+    use crate::geometry::Triangle;
+    use crate::heuristics::{
+        AllAxes, AxisChooser, CostModel, PahPerspective, PerspectiveMeasure, SahTermination,
+        Termination,
+    };
+    use crate::influence::PointArea;
+
+    fn check_graft<A: AxisChooser, C: CostModel, T: Termination>(
+        builder: &Builder<A, C, T>,
+        tris: &[Triangle],
+    ) {
+        let whole = builder.build(tris).unwrap();
         for cutoff in [1, 7, 100, 1000, 5000] {
             let mut arena = BuildArena::with_capacity(tris.len());
-            arena.load_triangles(&tris).unwrap();
+            arena.load_triangles(tris).unwrap();
             let mut top = Bvh::default();
             let mut jobs = Vec::new();
             builder
@@ -169,14 +177,79 @@ mod tests {
                     }
                     let mut out = Bvh::default();
                     builder
-                        .build_subtree_into(&mut local, &mut out, job.depth)
+                        .build_subtree_into(&mut local, &mut out, job)
                         .unwrap();
                     out
                 })
                 .collect();
             let grafted = Bvh::graft(top, &jobs, &subtrees).unwrap();
-            assert_eq!(grafted, whole, "cutoff {cutoff}");
+            assert!(grafted == whole, "cutoff {cutoff}");
         }
+    }
+
+    #[test]
+    fn grafted_tree_equals_single_threaded_tree() {
+        let tris = crate::test_scenes::soup(3000, 8, -10.0, 10.0, 0.5);
+        check_graft(&Builder::sah(), &tris);
+    }
+
+    #[test]
+    fn grafted_perspective_pah_tree_equals_single_threaded_tree() {
+        let mut tris = crate::test_scenes::soup(3000, 8, -10.0, 10.0, 0.5);
+        tris.extend(crate::test_scenes::soup(300, 9, -10.0, 10.0, 6.0));
+        for eye in [Vec3::new(0.0, 14.0, 0.0), Vec3::new(1.0, 2.0, 0.5)] {
+            let area = PointArea::new(eye, -Vec3::Y, 150.0, 150.0, 0.1, 30.0).unwrap();
+            for measure in [
+                PerspectiveMeasure::SolidAngle,
+                PerspectiveMeasure::ImagePlane,
+            ] {
+                let pah = PahPerspective::for_area(&area, measure);
+                let config = BuildConfig::default();
+                check_graft(
+                    &Builder::new(AllAxes, pah, SahTermination::default(), config),
+                    &tris,
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_subtree_build_takes_its_jobs_measure() {
+        // The measure a job carries is the root's: its splits are priced relative to it. Four
+        // overlapping triangles make one leaf (every split's children are as large as the
+        // node); a root said to measure far more than its box makes a split look cheap.
+        let tris: Vec<Triangle> = (0..4)
+            .map(|i| {
+                let d = 0.01 * i as f32;
+                Triangle::new(
+                    Vec3::new(d, 0.0, 0.0),
+                    Vec3::new(1.0, 1.0 - d, 0.0),
+                    Vec3::new(0.0, d, 1.0),
+                )
+            })
+            .collect();
+        let builder = Builder::sah();
+        let whole = builder.build(&tris).unwrap();
+        let mut arena = BuildArena::with_capacity(tris.len());
+        let root = whole.bounds();
+        let mut job = Subtree {
+            node: 0,
+            start: 0,
+            count: tris.len() as u32,
+            depth: 0,
+            measure: None,
+        };
+        let mut sub = |job: &Subtree| {
+            arena.load_triangles(&tris).unwrap();
+            let mut out = Bvh::default();
+            builder
+                .build_subtree_into(&mut arena, &mut out, job)
+                .unwrap();
+            out
+        };
+        assert!(sub(&job) == whole && whole.leaf_count() == 1);
+        job.measure = Some(1e3 * crate::heuristics::Sah.measure(&root));
+        assert!(sub(&job).leaf_count() > whole.leaf_count());
     }
 
     #[test]

@@ -49,12 +49,14 @@ pub struct ReinsertConfig {
 }
 
 impl Default for ReinsertConfig {
-    /// 1% of the nodes per pass, at most 2 passes, stop below a 0.1% gain, depth up to
-    /// [`MAX_DEPTH`] (see `benches/RESULTS.md` for the measurements behind these).
+    /// 2% of the nodes per pass, at most 3 passes, stop below a 0.1% gain, depth up to
+    /// [`MAX_DEPTH`]. Chosen by the 4-wide traversal cost over eleven views of Crytek Sponza and
+    /// Sibenik (`benches/examples/reinsert.rs`; numbers in `benches/RESULTS.md`): 0.75 and 0.80
+    /// of the unoptimized tree's, where 1% and 2 passes gave 0.87 and 0.85.
     fn default() -> Self {
         Self {
-            fraction: 0.01,
-            max_passes: 2,
+            fraction: 0.02,
+            max_passes: 3,
             min_gain: 0.001,
             max_depth: MAX_DEPTH,
         }

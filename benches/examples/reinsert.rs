@@ -60,7 +60,12 @@ fn views(b: &Aabb) -> Vec<(String, Vec<Ray>)> {
     let mut v: Vec<(String, Vec<Ray>)> = outside
         .iter()
         .enumerate()
-        .map(|(i, d)| (format!("out{i}"), camera(c + d.normalize() * 1.5 * r, c, 0.7, 128)))
+        .map(|(i, d)| {
+            (
+                format!("out{i}"),
+                camera(c + d.normalize() * 1.5 * r, c, 0.7, 128),
+            )
+        })
         .collect();
     v.extend(inside.iter().enumerate().map(|(i, (p, t))| {
         let (eye, target) = (b.min + e * *p, b.min + e * *t);
@@ -82,7 +87,10 @@ fn view_cost(wide: &WideBvh, rays: &[Ray]) -> f64 {
 /// Mrays/s of closest-hit queries over `rays`, thread CPU time; the hits' distances for checking.
 fn trace(wide: &WideBvh, rays: &[Ray]) -> (f64, Vec<Option<f32>>) {
     let t = thread_cpu_seconds();
-    let hits: Vec<Option<f32>> = rays.iter().map(|r| wide.closest_hit(r).map(|h| h.t)).collect();
+    let hits: Vec<Option<f32>> = rays
+        .iter()
+        .map(|r| wide.closest_hit(r).map(|h| h.t))
+        .collect();
     let s = thread_cpu_seconds() - t;
     (rays.len() as f64 / s / 1e6, hits)
 }
@@ -127,7 +135,10 @@ fn run(scene: &str, configs: &[(f32, u32)]) -> Result<(), String> {
         );
         trees.push((format!("{fraction}/{passes}"), tree));
     }
-    let wides: Vec<WideBvh> = trees.iter().map(|(_, t)| WideBvh::from_binary(t, &tris)).collect();
+    let wides: Vec<WideBvh> = trees
+        .iter()
+        .map(|(_, t)| WideBvh::from_binary(t, &tris))
+        .collect();
 
     let views = views(&b);
     let base_costs: Vec<f64> = views.iter().map(|(_, r)| view_cost(&wides[0], r)).collect();
@@ -178,7 +189,10 @@ fn main() -> ExitCode {
     };
     let mut configs = Vec::new();
     for pair in args[1..].chunks(2) {
-        match (pair[0].parse::<f32>(), pair.get(1).map(|p| p.parse::<u32>())) {
+        match (
+            pair[0].parse::<f32>(),
+            pair.get(1).map(|p| p.parse::<u32>()),
+        ) {
             (Ok(f), Some(Ok(p))) => configs.push((f, p)),
             _ => {
                 eprintln!("error: expected FRACTION PASSES pairs, got {pair:?}");

@@ -18,7 +18,7 @@
 use alloc::collections::BinaryHeap;
 use alloc::vec::Vec;
 use bytemuck::Zeroable;
-use core::cmp::Ordering;
+use core::cmp::Reverse;
 
 use crate::bvh::{Bvh, BvhNode, MAX_DEPTH};
 use crate::geometry::Aabb;
@@ -93,35 +93,29 @@ pub struct ReinsertStats {
     pub kept_for_depth: bool,
 }
 
-/// A node waiting in the branch-and-bound search, ordered so the heap pops the smallest induced
-/// cost first (ties: the lower node index, so the search is a function of the tree alone).
-#[derive(Clone, Copy, Debug)]
-struct Pending {
-    induced: f32,
-    node: u32,
-}
-
-impl PartialEq for Pending {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
+/// A float's bits, mapped so that unsigned order is [`f32::total_cmp`]'s order.
+#[inline(always)]
+fn ordered(x: f32) -> u32 {
+    let b = x.to_bits();
+    if b >> 31 == 1 {
+        !b
+    } else {
+        b | 1 << 31
     }
 }
 
-impl Eq for Pending {}
-
-impl PartialOrd for Pending {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
+/// The inverse of [`ordered`].
+#[inline(always)]
+fn unordered(k: u32) -> f32 {
+    f32::from_bits(if k >> 31 == 1 { k & !(1 << 31) } else { !k })
 }
 
-impl Ord for Pending {
-    fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .induced
-            .total_cmp(&self.induced)
-            .then(other.node.cmp(&self.node))
-    }
+/// A node waiting in the branch-and-bound search: its induced cost's [`ordered`] bits above its
+/// index, so the min-heap pops the smallest induced cost first, ties to the lower index (the
+/// search is a function of the tree alone), with one integer comparison.
+#[inline(always)]
+fn pending(induced: f32, node: u32) -> Reverse<u64> {
+    Reverse(u64::from(ordered(induced)) << 32 | u64::from(node))
 }
 
 /// Reinsertion with its working memory: the tree as parent and child links (node indices are the
@@ -133,8 +127,10 @@ pub struct Reinserter {
     children: Vec<[u32; 2]>,
     bounds: Vec<Aabb>,
     measure: Vec<f32>,
-    candidates: Vec<(f32, u32)>,
-    heap: BinaryHeap<Pending>,
+    /// Measure's [`ordered`] bits above the complemented index: descending order is the largest
+    /// measure first, ties to the lower index.
+    candidates: Vec<u64>,
+    heap: BinaryHeap<Reverse<u64>>,
     path: Vec<u32>,
     nodes: Vec<BvhNode>,
     prims: Vec<u32>,
@@ -176,7 +172,7 @@ impl Reinserter {
         for _ in 0..config.max_passes {
             self.pick(config.fraction);
             for k in 0..self.candidates.len() {
-                let node = self.candidates[k].1;
+                let node = u32::MAX - self.candidates[k] as u32;
                 stats.tried += 1;
                 stats.moved += u32::from(self.reinsert(node, model));
             }
@@ -244,9 +240,9 @@ impl Reinserter {
                 .iter()
                 .enumerate()
                 .filter(|&(i, &m)| i as u32 != root && m > 0.0 && m.is_finite())
-                .map(|(i, &m)| (m, i as u32)),
+                .map(|(i, &m)| u64::from(ordered(m)) << 32 | u64::from(u32::MAX - i as u32)),
         );
-        let order = |a: &(f32, u32), b: &(f32, u32)| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1));
+        let order = |a: &u64, b: &u64| b.cmp(a);
         let keep = (libm::ceil(self.candidates.len() as f64 * f64::from(fraction)) as usize)
             .min(self.candidates.len());
         if keep == 0 {
@@ -279,11 +275,9 @@ impl Reinserter {
         let stay = self.cost_beside(sibling, &nb, model);
         let (mut best, mut best_cost) = (sibling, stay - stay * MIN_GAIN);
         self.heap.clear();
-        self.heap.push(Pending {
-            induced: 0.0,
-            node: self.root,
-        });
-        while let Some(Pending { induced, node: x }) = self.heap.pop() {
+        self.heap.push(pending(0.0, self.root));
+        while let Some(Reverse(key)) = self.heap.pop() {
+            let (induced, x) = (unordered((key >> 32) as u32), key as u32);
             // Every place below costs at least the induced cost plus the new node's own measure.
             if induced + nm >= best_cost {
                 break;
@@ -297,8 +291,8 @@ impl Reinserter {
             if l != NONE {
                 let induced = induced + (joined - self.measure[x as usize]);
                 if induced + nm < best_cost {
-                    self.heap.push(Pending { induced, node: l });
-                    self.heap.push(Pending { induced, node: r });
+                    self.heap.push(pending(induced, l));
+                    self.heap.push(pending(induced, r));
                 }
             }
         }
@@ -600,6 +594,28 @@ mod tests {
             assert_eq!(bvh.bounds(), built.bounds());
             let (before, after) = (built.estimated_cost(&Sah, k), bvh.estimated_cost(&Sah, k));
             assert!(after <= before, "{stats:?}: {before} -> {after}");
+        }
+    }
+
+    #[test]
+    fn ordered_bits_sort_as_total_cmp() {
+        let xs = [
+            f32::NEG_INFINITY,
+            -3.5,
+            -f32::MIN_POSITIVE,
+            -0.0,
+            0.0,
+            1e-40,
+            f32::MIN_POSITIVE,
+            1.0,
+            2.5e30,
+            f32::INFINITY,
+        ];
+        for a in xs {
+            assert_eq!(unordered(ordered(a)).to_bits(), a.to_bits());
+            for b in xs {
+                assert_eq!(ordered(a).cmp(&ordered(b)), a.total_cmp(&b), "{a} {b}");
+            }
         }
     }
 }

@@ -2,8 +2,9 @@
 //! throughput in triangles. `build/SCENE/LIB` is the single-threaded build (inside a one-thread
 //! rayon pool, so obvhs's `parallel` feature cannot spread it; clock per `RDBVH_BENCH_CLOCK`),
 //! `build_mt/SCENE/LIB` the threaded build on every core, always in wall time (its work is on
-//! several threads), and `build_pah/SCENE/...` rdbvh's SAH preset beside PAH + SPFH (`full`) with
-//! a plane and a point area over the scene. These are the rows of the `peers` binary's table.
+//! several threads), `build_pah/SCENE/...` rdbvh's SAH preset beside PAH + SPFH (`full`) with
+//! a plane and a point area over the scene, and `reinsert/SCENE` the reinsertion pass alone. These
+//! are the rows of the `peers` binary's table.
 //!
 //! Each library builds from triangles already in its own format (converted once, untimed); the
 //! timed build includes bounding the triangles, which every builder must do. Outputs are dropped
@@ -17,14 +18,15 @@ use std::time::Duration;
 use clock::Clock;
 use criterion::measurement::{Measurement, WallTime};
 use criterion::{
-    criterion_group, criterion_main, BenchmarkGroup, Criterion, SamplingMode, Throughput,
+    criterion_group, criterion_main, BatchSize, BenchmarkGroup, Criterion, SamplingMode, Throughput,
 };
 use rdbvh_benches::compare::{plane_area_over, point_area_over};
 use rdbvh_benches::peers::{BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Rdbvh, RdbvhWide};
 use rdbvh_benches::{bounds, load_scene, single_thread_pool, RdbvhReuse, BENCH_SCENES};
-use rdbvh_core::build::{BuildArena, Preset, PresetOptions};
+use rdbvh_core::build::{BuildArena, Preset, PresetOptions, ReinsertConfig, Reinserter};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
+use rdbvh_core::heuristics::Sah;
 use rdbvh_core::influence::InfluenceArea;
 
 /// The single-threaded build, measured on the pool's one thread (where the clock is read).
@@ -127,6 +129,25 @@ fn builds(c: &mut Criterion<Clock>) {
                 })
             });
         }
+        group.finish();
+
+        // Reinsertion alone (the step `rdbvh-wide`'s build adds), on a copy of the SAH tree made
+        // outside the timing.
+        let mut group = c.benchmark_group(format!("reinsert/{name}"));
+        configure(&mut group, tris.len());
+        let built = Rdbvh::build(&mut tris.clone());
+        let mut reinserter = Reinserter::new();
+        group.bench_function("sah-default", |bench| {
+            bench.iter_batched_ref(
+                || built.clone(),
+                |tree| {
+                    reinserter
+                        .optimize(tree, &Sah, &ReinsertConfig::default())
+                        .moved
+                },
+                BatchSize::LargeInput,
+            )
+        });
         group.finish();
     }
 }

@@ -12,8 +12,8 @@
 //! (`C_trav * sum of inner measures + C_isect * sum of leaf measures x counts`, over the root's)
 //! changes only through the inner nodes' measures. Inserting node `N` beside node `X` makes one
 //! inner node of measure `m(X u N)` and grows every ancestor `A` of `X` by `m(A u N) - m(A)`; the
-//! search keeps the `X` with the least such sum. The node's old place is priced first and wins
-//! ties, so a move is made only when it strictly lowers the cost, and the cost never grows.
+//! search keeps the `X` with the least such sum. The node's old place is priced first and a new
+//! place must beat it by more than rounding could fake, so the cost never grows.
 
 use alloc::collections::BinaryHeap;
 use alloc::vec::Vec;
@@ -65,12 +65,13 @@ impl Default for ReinsertConfig {
 
 impl ReinsertConfig {
     /// True when the settings make sense: `fraction` in `(0, 1]`, `min_gain` finite and not
-    /// negative.
+    /// negative, `max_depth` at most [`MAX_DEPTH`].
     pub fn is_valid(&self) -> bool {
         self.fraction > 0.0
             && self.fraction <= 1.0
             && self.min_gain.is_finite()
             && self.min_gain >= 0.0
+            && self.max_depth <= MAX_DEPTH
     }
 }
 
@@ -509,6 +510,10 @@ mod tests {
             },
             ReinsertConfig {
                 max_passes: 0,
+                ..ReinsertConfig::default()
+            },
+            ReinsertConfig {
+                max_depth: MAX_DEPTH + 1,
                 ..ReinsertConfig::default()
             },
         ] {

@@ -412,6 +412,38 @@ impl Reinserter {
 }
 
 /// [`Reinserter::optimize`] with fresh working memory.
+///
+/// A renderer that traces many rays per build builds, reinserts, then collapses to 4-wide nodes:
+///
+/// ```
+/// use rdbvh_core::build::{reinsert, Builder, ReinsertConfig};
+/// use rdbvh_core::bvh::WideBvh;
+/// use rdbvh_core::geometry::{Ray, Triangle};
+/// use rdbvh_core::heuristics::{CostConstants, Sah};
+/// use rdbvh_core::Vec3;
+///
+/// // A row of long thin triangles crossed by small ones.
+/// let mut tris: Vec<Triangle> = (0..64)
+///     .map(|i| {
+///         let o = Vec3::new((i % 8) as f32, (i / 8) as f32, 0.0);
+///         Triangle::new(o, o + Vec3::X * 0.3, o + Vec3::Y * 0.3)
+///     })
+///     .collect();
+/// tris.extend((0..8).map(|i| {
+///     let y = i as f32;
+///     Triangle::new(Vec3::new(-1.0, y, 0.5), Vec3::new(9.0, y, 0.5), Vec3::new(-1.0, y + 0.1, 0.6))
+/// }));
+/// let mut bvh = Builder::sah().build(&tris)?;
+/// let before = bvh.estimated_cost(&Sah, CostConstants::default());
+/// let stats = reinsert(&mut bvh, &Sah, &ReinsertConfig::default());
+/// assert!(bvh.estimated_cost(&Sah, CostConstants::default()) <= before);
+/// assert!(stats.tried > 0);
+///
+/// let wide = WideBvh::from_binary(&bvh, &tris);
+/// let ray = Ray::new(Vec3::new(2.1, 3.1, -1.0), Vec3::Z)?;
+/// assert_eq!(wide.closest_hit(&ray), bvh.closest_hit(&ray, &tris));
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
 pub fn reinsert<M: CostModel>(bvh: &mut Bvh, model: &M, config: &ReinsertConfig) -> ReinsertStats {
     Reinserter::new().optimize(bvh, model, config)
 }

@@ -193,6 +193,7 @@ pub fn build_scene<L: AreaLookup>(
             .preset
             .build_into(Some(area), &options.local, &mut arena, &mut bvh)
             .map_err(fail)?;
+        options.reinsert_local(area, &mut bvh);
         Ok(bvh)
     };
     let fallback_build = || {
@@ -205,6 +206,7 @@ pub fn build_scene<L: AreaLookup>(
             .fallback_preset
             .build_into(None, &options.fallback, &mut arena, &mut bvh)
             .map_err(SceneError::Fallback)?;
+        options.reinsert_fallback(&mut bvh);
         Ok::<_, SceneError>(bvh)
     };
     let (local, fallback) = rayon::join(
@@ -227,7 +229,7 @@ pub fn build_scene<L: AreaLookup>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rdbvh_core::build::BuildConfig;
+    use rdbvh_core::build::{BuildConfig, ReinsertConfig};
     use rdbvh_core::heuristics::{AllAxes, PahPerspective, PerspectiveMeasure, SahTermination};
     use rdbvh_core::influence::{PlaneArea, PointArea};
     use rdbvh_core::random::Pcg32;
@@ -320,7 +322,16 @@ mod tests {
 
     #[test]
     fn threaded_scene_equals_single_threaded() {
-        let tris = soup(5_000);
+        let mut tris = soup(5_000);
+        // Long triangles across the soup, so that reinsertion moves something.
+        tris.extend((0..100).map(|i| {
+            let y = i as f32 * 0.2 - 10.0;
+            Triangle::new(
+                Vec3::new(-10.0, y, -10.0),
+                Vec3::new(10.0, y, 10.0),
+                Vec3::new(-10.0, y + 0.1, 10.0),
+            )
+        }));
         let areas: Vec<InfluenceArea> = vec![
             PlaneArea::new(Vec3::new(0.0, 0.0, -12.0), Vec3::Z, 6.0, 6.0, 20.0)
                 .unwrap()
@@ -329,10 +340,20 @@ mod tests {
                 .unwrap()
                 .into(),
         ];
-        let options = SceneOptions::default();
-        let a = build_scene(&tris, areas.clone(), &options, |a| Octree::build(a, 5)).unwrap();
-        let b = Scene::with_octree(&tris, areas, &options, 5).unwrap();
-        assert_eq!(a.local_bvhs(), b.local_bvhs());
-        assert_eq!(a.fallback(), b.fallback());
+        let plain = SceneOptions::default();
+        let reinserted = SceneOptions {
+            reinsert: Some(ReinsertConfig::default()),
+            ..plain
+        };
+        let mut fallbacks = Vec::new();
+        for options in [plain, reinserted] {
+            let a = build_scene(&tris, areas.clone(), &options, |a| Octree::build(a, 5)).unwrap();
+            let b = Scene::with_octree(&tris, areas.clone(), &options, 5).unwrap();
+            assert_eq!(a.local_bvhs(), b.local_bvhs());
+            assert_eq!(a.fallback(), b.fallback());
+            fallbacks.push(a.fallback().clone());
+        }
+        // The option reaches the trees.
+        assert!(fallbacks[0] != fallbacks[1], "reinsertion changed nothing");
     }
 }

@@ -9,7 +9,7 @@
 
 use proptest::prelude::*;
 use rdbvh_core::brute_force;
-use rdbvh_core::build::Preset;
+use rdbvh_core::build::{Preset, ReinsertConfig};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::influence::{InfluenceArea, PlaneArea, PointArea, RaySampler};
 use rdbvh_core::toplevel::{Octree, Scene, SceneOptions};
@@ -94,8 +94,11 @@ proptest! {
         preset in prop::sample::select(vec![Preset::Full, Preset::Facing, Preset::Sah]),
         max_tries in 1u32..3,
         seed in any::<u64>(),
+        reinsert in any::<bool>(),
     ) {
-        let options = SceneOptions { preset, max_tries, ..SceneOptions::default() };
+        // Every tree reinserted (every node tried) or as built: the answers are the same.
+        let reinsert = reinsert.then_some(ReinsertConfig { fraction: 1.0, ..ReinsertConfig::default() });
+        let options = SceneOptions { preset, max_tries, reinsert, ..SceneOptions::default() };
         let octree = Scene::with_octree(&tris, areas.clone(), &options, 4).unwrap();
         let list = Scene::with_list(&tris, areas.clone(), &options).unwrap();
         let mut rng = rdbvh_tests::Rng::new(seed);

@@ -3,8 +3,8 @@
 use core::fmt;
 
 use super::{
-    BinSpace, BuildArena, BuildConfig, BuildStats, Builder, Clock, CutEvaluation, NoClock,
-    ThesisCut,
+    reinsert, BinSpace, BuildArena, BuildConfig, BuildStats, Builder, Clock, CutEvaluation,
+    NoClock, ReinsertConfig, ReinsertStats, ThesisCut,
 };
 use crate::bvh::{Bvh, MAX_DEPTH};
 use crate::geometry::Aabb;
@@ -261,6 +261,24 @@ impl CostModel for AreaPah {
 }
 
 impl Preset {
+    /// Improves `bvh`, built with this preset (for `area` when it needs one), by reinsertion
+    /// under the preset's own cost model: the area's PAH (with `options.perspective`) for the PAH
+    /// presets, SAH for the others, so the tree stays good where the preset's rays go.
+    pub fn reinsert(
+        self,
+        area: Option<&InfluenceArea>,
+        options: &PresetOptions,
+        bvh: &mut Bvh,
+        config: &ReinsertConfig,
+    ) -> ReinsertStats {
+        match area {
+            Some(a) if self.uses_pah() => {
+                reinsert(bvh, &AreaPah::new(a, options.perspective), config)
+            }
+            _ => reinsert(bvh, &Sah, config),
+        }
+    }
+
     /// Builds the arena's primitives with this preset into `out`. `area` is required for
     /// `facing`, `longest` and `full`, ignored by `sah` and `standard`.
     pub fn build_into(

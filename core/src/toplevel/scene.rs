@@ -4,7 +4,7 @@ use alloc::vec::Vec;
 use core::fmt;
 
 use super::{AreaList, AreaLookup, BreakEven, Octree};
-use crate::build::{BuildArena, Preset, PresetError, PresetOptions};
+use crate::build::{BuildArena, Preset, PresetError, PresetOptions, ReinsertConfig};
 use crate::bvh::{Bvh, Hit, Traversable, TraversalStats, WideBvh};
 use crate::geometry::{Ray, Triangle};
 use crate::heuristics::CostConstants;
@@ -29,6 +29,9 @@ pub struct SceneOptions {
     pub fallback: PresetOptions,
     /// How many affine areas a query tries before falling back (the thesis used 1).
     pub max_tries: u32,
+    /// Reinsertion after each build, or none (the default): every local BVH under its preset's
+    /// model ([`Preset::reinsert`]: the area's PAH for the PAH presets), the fallback under SAH.
+    pub reinsert: Option<ReinsertConfig>,
 }
 
 impl Default for SceneOptions {
@@ -39,6 +42,24 @@ impl Default for SceneOptions {
             fallback_preset: Preset::Sah,
             fallback: PresetOptions::default(),
             max_tries: 1,
+            reinsert: None,
+        }
+    }
+}
+
+impl SceneOptions {
+    /// Applies [`SceneOptions::reinsert`] to the local BVH built for `area`.
+    pub fn reinsert_local(&self, area: &InfluenceArea, bvh: &mut Bvh) {
+        if let Some(config) = &self.reinsert {
+            self.preset.reinsert(Some(area), &self.local, bvh, config);
+        }
+    }
+
+    /// Applies [`SceneOptions::reinsert`] to the fallback BVH.
+    pub fn reinsert_fallback(&self, bvh: &mut Bvh) {
+        if let Some(config) = &self.reinsert {
+            self.fallback_preset
+                .reinsert(None, &self.fallback, bvh, config);
         }
     }
 }
@@ -156,6 +177,7 @@ impl<L: AreaLookup> Scene<L> {
                 .preset
                 .build_into(Some(area), &options.local, &mut arena, &mut bvh)
                 .map_err(fail)?;
+            options.reinsert_local(area, &mut bvh);
             local.push(bvh);
         }
         arena
@@ -166,6 +188,7 @@ impl<L: AreaLookup> Scene<L> {
             .fallback_preset
             .build_into(None, &options.fallback, &mut arena, &mut fallback)
             .map_err(SceneError::Fallback)?;
+        options.reinsert_fallback(&mut fallback);
         let lookup = lookup(&areas);
         Ok(Self {
             areas,

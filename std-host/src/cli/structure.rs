@@ -7,7 +7,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use rdbvh_core::build::{Preset, PresetOptions};
+use rdbvh_core::build::{Preset, PresetOptions, ReinsertConfig};
 use rdbvh_core::bvh::{Bvh, TraversalStats};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::CostConstants;
@@ -151,7 +151,8 @@ fn fallback_alone(
 }
 
 /// The scene-structure options of a command line: the local preset (`full` unless --preset says
-/// otherwise) with --thesis-mode/--bins/--max-leaf, the fallback with the defaults.
+/// otherwise) with --thesis-mode/--bins/--max-leaf, the fallback with the defaults, and with
+/// --reinsert every tree reinserted with the default settings.
 pub fn structure_options(args: &TraceArgs) -> SceneOptions {
     SceneOptions {
         preset: args.builder.preset().unwrap_or(DEFAULT_LOCAL_PRESET),
@@ -159,6 +160,7 @@ pub fn structure_options(args: &TraceArgs) -> SceneOptions {
         fallback_preset: Preset::Sah,
         fallback: PresetOptions::default(),
         max_tries: args.max_tries,
+        reinsert: args.builder.reinsert.then(ReinsertConfig::default),
     }
 }
 

@@ -131,13 +131,6 @@ pub fn trace<T: Traversable + Sync>(
 /// Runs `rdbvh trace`; the summary goes to `log` (standard error), so standard output stays free.
 pub fn run(args: &TraceArgs, log: &mut impl Write) -> Result<(), CliError> {
     if let Some(areas) = &args.areas {
-        if args.builder.reinsert {
-            return Err(CliError::Usage(
-                "--reinsert improves one BVH; with --areas the scene structure builds many \
-                 (drop one of them)"
-                    .into(),
-            ));
-        }
         return structure::run(args, areas, log);
     }
     args.builder.check_area(false)?;

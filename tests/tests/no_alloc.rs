@@ -1,4 +1,5 @@
-//! Proof that a build over a caller-sized arena allocates nothing, and neither do the traversals.
+//! Proof that a build over a caller-sized arena allocates nothing, and neither do the traversals
+//! or a reused reinsertion.
 //!
 //! A counting global allocator counts calls per thread (a `const` thread-local, so counting itself
 //! never allocates), and each measurement reads the count of its own thread only, so tests running
@@ -8,7 +9,10 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::hint::black_box;
 
-use rdbvh_core::build::{BinSpace, BuildArena, BuildConfig, Builder, CutEvaluation, ThesisCut};
+use rdbvh_core::build::{
+    BinSpace, BuildArena, BuildConfig, Builder, CutEvaluation, ReinsertConfig, Reinserter,
+    ThesisCut,
+};
 use rdbvh_core::bvh::{Bvh, TraversalStats};
 use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 use rdbvh_core::heuristics::{
@@ -178,4 +182,30 @@ fn traversals_allocate_nothing() {
         "{hits} {any} {all}"
     );
     assert!(stats.inner_nodes > 0 && stats.triangles > 0, "{stats:?}");
+}
+
+/// A `Reinserter` reused on the same tree again allocates nothing: its working memory, and the
+/// output arrays it traded for the first tree's, are large enough.
+#[test]
+fn a_reused_reinserter_allocates_nothing() {
+    let mut tris = soup(4000, 5);
+    // Long triangles across the soup, so that reinsertion has something to move.
+    tris.extend((0..60).map(|i| {
+        let y = i as f32 * 0.3 - 9.0;
+        Triangle::new(
+            Vec3::new(-10.0, y, -10.0),
+            Vec3::new(10.0, y, 10.0),
+            Vec3::new(-10.0, y + 0.1, 10.0),
+        )
+    }));
+    let built = Builder::sah().build(&tris).unwrap();
+    let config = ReinsertConfig::default();
+    let mut reinserter = Reinserter::new();
+    let mut first = built.clone();
+    let once = reinserter.optimize(&mut first, &Sah, &config);
+    assert!(once.moved > 0, "{once:?}");
+    let mut again = built.clone();
+    let (calls, twice) = allocator_calls(|| reinserter.optimize(&mut again, &Sah, &config));
+    assert_eq!(calls, 0, "reinsertion allocated {calls} times");
+    assert_eq!((twice, &again), (once, &first));
 }

@@ -121,7 +121,8 @@ fn pending(induced: f32, node: u32) -> Reverse<u64> {
 
 /// Reinsertion with its working memory: the tree as parent and child links (node indices are the
 /// input's, and stay fixed while nodes move), the search heap, and the output arrays. Reuse one
-/// across trees to allocate only when a tree is larger than any before.
+/// across trees to allocate only when a tree, or a search's heap, needs more room than any before
+/// (the output arrays trade places with the tree's, so their memory is reused too).
 #[derive(Clone, Debug, Default)]
 pub struct Reinserter {
     parent: Vec<u32>,

@@ -14,29 +14,17 @@
 use std::process::ExitCode;
 
 use glam::Vec3;
-use rdbvh_benches::{bounds, load_scene, random_rays, ray_set, thread_cpu_seconds, RayKind};
+use rdbvh_benches::{
+    bounds, load_scene, pinhole_rays, random_rays, ray_set, thread_cpu_seconds, RayKind,
+};
 use rdbvh_core::build::{Builder, ReinsertConfig, Reinserter};
 use rdbvh_core::bvh::{Bvh, TraversalStats, WideBvh};
 use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 use rdbvh_core::heuristics::{CostConstants, Sah};
 
-/// `side` x `side` rays of a pinhole camera at `eye` looking at `target`, the half field of view's
-/// tangent `half`.
-fn camera(eye: Vec3, target: Vec3, half: f32, side: u32) -> Vec<Ray> {
-    let forward = (target - eye).normalize();
-    let right = forward.cross(Vec3::Y).normalize();
-    let up = right.cross(forward);
-    let mut rays = Vec::with_capacity((side * side) as usize);
-    for y in 0..side {
-        for x in 0..side {
-            let sx = ((x as f32 + 0.5) / side as f32 * 2.0 - 1.0) * half;
-            let sy = (1.0 - (y as f32 + 0.5) / side as f32 * 2.0) * half;
-            if let Ok(r) = Ray::new(eye, forward + right * sx + up * sy) {
-                rays.push(r);
-            }
-        }
-    }
-    rays
+/// 128 x 128 rays from `eye` towards `target`, the half field of view's tangent `half`.
+fn camera(eye: Vec3, target: Vec3, half: f32) -> Vec<Ray> {
+    pinhole_rays(eye, (target - eye).normalize(), half, 128)
 }
 
 /// The eleven views of the module docs.
@@ -63,13 +51,13 @@ fn views(b: &Aabb) -> Vec<(String, Vec<Ray>)> {
         .map(|(i, d)| {
             (
                 format!("out{i}"),
-                camera(c + d.normalize() * 1.5 * r, c, 0.7, 128),
+                camera(c + d.normalize() * 1.5 * r, c, 0.7),
             )
         })
         .collect();
     v.extend(inside.iter().enumerate().map(|(i, (p, t))| {
         let (eye, target) = (b.min + e * *p, b.min + e * *t);
-        (format!("in{i}"), camera(eye, target, 1.0, 128))
+        (format!("in{i}"), camera(eye, target, 1.0))
     }));
     v.push(("random".into(), random_rays(b, 32_768, 7)));
     v

@@ -168,13 +168,22 @@ pub fn camera_rays(b: &Aabb, side: u32) -> Vec<Ray> {
             (v.dot(right) / depth).abs().max((v.dot(up) / depth).abs())
         })
         .fold(f32::MIN_POSITIVE, f32::max);
+    pinhole_rays(eye, forward, half, side)
+}
+
+/// Primary rays of a `side` x `side` pinhole camera at `eye` looking along the unit `forward`
+/// (not vertical), the half field of view's tangent `half`, row by row from the top left. Rays
+/// whose direction is not finite are skipped.
+pub fn pinhole_rays(eye: Vec3, forward: Vec3, half: f32, side: u32) -> Vec<Ray> {
+    let right = forward.cross(Vec3::Y).normalize();
+    let up = right.cross(forward);
     let mut rays = Vec::with_capacity((side * side) as usize);
     for y in 0..side {
         for x in 0..side {
             let sx = ((x as f32 + 0.5) / side as f32 * 2.0 - 1.0) * half;
             let sy = (1.0 - (y as f32 + 0.5) / side as f32 * 2.0) * half;
             let dir = (forward + right * sx + up * sy).normalize();
-            rays.push(Ray::new(eye, dir).expect("finite eye and unit direction"));
+            rays.extend(Ray::new(eye, dir).ok());
         }
     }
     rays

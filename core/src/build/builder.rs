@@ -395,7 +395,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             count: n as u32,
             depth,
             centroids: arena.centroids,
-            measure: measure.unwrap_or(f32::NAN),
+            measure,
         };
         loop {
             stats.max_depth = stats.max_depth.max(task.depth);
@@ -406,7 +406,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                         start: task.start,
                         count: task.count,
                         depth: task.depth,
-                        measure: (!task.measure.is_nan()).then_some(task.measure),
+                        measure: task.measure,
                     };
                     jobs.take(job, arena);
                     true
@@ -435,7 +435,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                         count: right.1,
                         depth,
                         centroids: right.2,
-                        measure: measures[1],
+                        measure: measures.map(|m| m[1]),
                     });
                     task = Task {
                         node: l,
@@ -444,7 +444,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
                         count: left.1,
                         depth,
                         centroids: left.2,
-                        measure: measures[0],
+                        measure: measures.map(|m| m[0]),
                     };
                     continue;
                 }
@@ -462,7 +462,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
 
     /// Decides one node: `None` for a leaf, or the two children after partitioning the node's
     /// slots in place, with their measures under the builder's model when the split priced them
-    /// under it (NaN otherwise).
+    /// under it.
     fn split(
         &self,
         arena: &mut BuildArena,
@@ -470,7 +470,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         stats: &mut BuildStats,
         clock: &impl Clock,
         binner: &impl NodeBinner,
-    ) -> Option<(Child, Child, [f32; 2])> {
+    ) -> Option<(Child, Child, Option<[f32; 2]>)> {
         let (count, bounds) = (task.count, &task.bounds);
         if task.depth >= self.config.max_depth || count <= 1 {
             return None;
@@ -482,13 +482,9 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         if task.depth + ceil_log2(count) >= self.config.max_depth {
             stats.median_splits += 1;
             let (l, r) = median_split(&mut arena.refs, task);
-            return Some((l, r, [f32::NAN; 2]));
+            return Some((l, r, None));
         }
-        let parent = if task.measure.is_nan() {
-            self.cost.measure(bounds)
-        } else {
-            task.measure
-        };
+        let parent = task.measure.unwrap_or_else(|| self.cost.measure(bounds));
         let modelled = parent > 0.0 && parent.is_finite();
         let chosen = if modelled {
             self.choose(
@@ -522,7 +518,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             }
             stats.median_splits += 1;
             let (l, r) = median_split(&mut arena.refs, task);
-            return Some((l, r, [f32::NAN; 2]));
+            return Some((l, r, None));
         };
         let split_cost = k.traversal + k.intersection * relative;
         if self.termination.prefer_leaf(count, leaf_cost, split_cost) {
@@ -533,12 +529,8 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             Partition::Mask(mask) => partition_mask(arena, task, &best, mask),
         };
         // The children's boxes are the cut's, so its measures are theirs; under the SAH stand-in
-        // they are SAH's, not the model's, and the children measure themselves (NaN).
-        let measures = if modelled {
-            [best.cut.measure_left, best.cut.measure_right]
-        } else {
-            [f32::NAN; 2]
-        };
+        // they are SAH's, not the model's, and the children measure themselves.
+        let measures = modelled.then_some([best.cut.measure_left, best.cut.measure_right]);
         Some((l, r, measures))
     }
 

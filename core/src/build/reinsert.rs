@@ -85,7 +85,8 @@ pub struct ReinsertStats {
     /// Nodes put back somewhere else.
     pub moved: u32,
     /// The inner nodes' summed measure over the root's, before and after: the tree's cost under
-    /// the model fell by `C_trav` times the difference.
+    /// the model fell by about `C_trav` times the difference (the stored root keeps the build's
+    /// box, a hair larger than its children's union).
     pub inner_before: f32,
     /// See [`ReinsertStats::inner_before`].
     pub inner_after: f32,
@@ -382,6 +383,8 @@ impl Reinserter {
                 self.bounds[node as usize]
             };
             let [l, r] = self.children[node as usize];
+            // Written directly, not by `BvhNode::leaf`/`inner`: those pad, and these boxes are
+            // already the padded leaves' or unions of them.
             let out = if l == NONE {
                 let leaf = &bvh.nodes[node as usize];
                 let first = self.prims.len() as u32;
@@ -460,6 +463,14 @@ mod tests {
     use crate::heuristics::{CostConstants, Sah};
     use crate::random::Pcg32;
 
+    /// Small triangles among long ones crossing the scene, as in an architectural model: a
+    /// binned build leaves room for reinsertion there.
+    fn small_among_long() -> Vec<Triangle> {
+        let mut tris = crate::test_scenes::soup(3000, 5, -10.0, 10.0, 0.5);
+        tris.extend(crate::test_scenes::soup(150, 6, -10.0, 10.0, 10.0));
+        tris
+    }
+
     fn check(bvh: &Bvh, tris: &[Triangle]) {
         bvh.validate(tris.len(), |i| tris[i as usize].bounds())
             .unwrap();
@@ -467,10 +478,7 @@ mod tests {
 
     #[test]
     fn lowers_the_cost_and_keeps_every_answer() {
-        // Small triangles among long ones crossing the scene, as in an architectural model: a
-        // binned build leaves room for reinsertion there.
-        let mut tris = crate::test_scenes::soup(3000, 5, -10.0, 10.0, 0.5);
-        tris.extend(crate::test_scenes::soup(150, 6, -10.0, 10.0, 10.0));
+        let tris = small_among_long();
         let built = Builder::sah().build(&tris).unwrap();
         let mut bvh = built.clone();
         let stats = reinsert(&mut bvh, &Sah, &ReinsertConfig::default());
@@ -594,8 +602,7 @@ mod tests {
     #[test]
     fn a_tree_past_the_depth_bound_is_not_kept() {
         // A bound below any tree over these triangles.
-        let mut tris = crate::test_scenes::soup(3000, 5, -10.0, 10.0, 0.5);
-        tris.extend(crate::test_scenes::soup(150, 6, -10.0, 10.0, 10.0));
+        let tris = small_among_long();
         let built = Builder::sah().build(&tris).unwrap();
         let mut bvh = built.clone();
         let config = ReinsertConfig {

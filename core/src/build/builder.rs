@@ -824,10 +824,15 @@ fn sweep_any<M: CostModel>(bins: &[Bin], sweep: &mut Sweep, model: &M, hint: u32
         acc.merge(&bins[i - 1]);
         sweep.left.set(i, &acc);
     }
-    // Lanes past the last boundary, up to the end of its group of four: no primitive on the
-    // right prices them as +inf.
+    // Lanes past the last boundary, up to the end of its group of four: empty on both sides, so
+    // they price as +inf (no primitive on the right) and never hold a box left by an earlier,
+    // wider sweep. A model may choose how to measure a group from all four of its lanes
+    // (perspective PAH's far-field test does), so a stale box there could change what the
+    // real lanes cost: a reused arena and a fresh one (a threaded build's job) would then
+    // price the same node differently.
     for i in nb..=(nb - 1).div_ceil(4) * 4 {
-        sweep.right.count[i] = 0;
+        sweep.left.set(i, &Bin::EMPTY);
+        sweep.right.set(i, &Bin::EMPTY);
     }
     // The cheapest boundary per lane, then across lanes. Boundaries with an empty side, and the
     // padding lanes past the last boundary (count 0), price as +inf. Strict `<` keeps the first
@@ -1331,5 +1336,55 @@ mod tests {
         let pivot = arena.refs.centroid2_axis(n / 2, 0);
         assert!((0..n / 2).all(|i| arena.refs.centroid2_axis(i, 0) <= pivot));
         assert!((n / 2..n).all(|i| arena.refs.centroid2_axis(i, 0) >= pivot));
+    }
+
+    #[test]
+    fn a_sweep_prices_the_same_whatever_an_earlier_sweep_left() {
+        // Perspective PAH chooses its rule (far-field or exact) per group of four boxes, so a
+        // lane past the last boundary must hold the same thing in every sweep: left over from a
+        // wider sweep, it once made a fresh arena (a threaded job's) and a reused one (the
+        // single-threaded build's) price the same boundaries a few ulps apart.
+        use crate::heuristics::{PahPerspective, PerspectiveMeasure};
+        use crate::influence::PointArea;
+        let area = PointArea::new(Vec3::ZERO, Vec3::Z, 60.0, 60.0, 0.1, 1e4).unwrap();
+        let pah = PahPerspective::for_area(&area, PerspectiveMeasure::SolidAngle);
+        // Four bins in a row 1e3 ahead: each candidate box is far (half-diagonal under 1% of its
+        // distance: the far-field rule), but the node as a whole is not quite, so no hint
+        // settles it and the sweep decides per group. And a box near the eye (exact) to leave
+        // behind.
+        let bins: [Bin; 4] = core::array::from_fn(|i| {
+            let lo = Vec3::new(i as f32 * 4.975 - 9.95, -0.01, 1e3);
+            let hi = lo + Vec3::new(4.975, 0.02, 0.02);
+            let mut b = Bin::EMPTY;
+            b.grow(
+                f32x4::from(lo.extend(0.0).to_array()),
+                f32x4::from(hi.extend(0.0).to_array()),
+            );
+            b.count = 1;
+            b
+        });
+        let mut near = Bin::EMPTY;
+        near.grow(
+            f32x4::from([-1.0, -1.0, 1.0, 0.0]),
+            f32x4::from([1.0, 1.0, 3.0, 0.0]),
+        );
+        let node = bins.iter().fold(Aabb::EMPTY, |b, bin| {
+            let (lo, hi) = (bin.min.to_array(), bin.max.to_array());
+            b.union(Aabb::new(
+                Vec3::from_slice(&lo[..3]),
+                Vec3::from_slice(&hi[..3]),
+            ))
+        });
+        let hint = pah.hint(&node);
+        let mut fresh = BuildArena::with_capacity(0);
+        let mut reused = BuildArena::with_capacity(0);
+        for i in 0..=crate::build::MAX_BINS as usize {
+            reused.sweep.left.set(i, &near);
+            reused.sweep.right.set(i, &near);
+        }
+        let a = sweep_axis(&bins, &mut fresh.sweep, &pah, hint).unwrap();
+        let b = sweep_axis(&bins, &mut reused.sweep, &pah, hint).unwrap();
+        let bits = |c: &Cut| [c.weighted, c.measure_left, c.measure_right].map(f32::to_bits);
+        assert_eq!((a.at, bits(&a)), (b.at, bits(&b)));
     }
 }

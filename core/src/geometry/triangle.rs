@@ -20,7 +20,43 @@ pub struct Triangle {
 static_assertions::assert_eq_size!(Triangle, [f32; 9]);
 
 /// `(8 eps)^2`: a determinant below `8 eps |d| |e1| |e2|` is rounding noise.
-const DET_EPSILON_SQ: f32 = (8.0 * f32::EPSILON) * (8.0 * f32::EPSILON);
+const DET_EPSILON_SQ: f64 = (8.0 * f32::EPSILON as f64) * (8.0 * f32::EPSILON as f64);
+
+/// `(2^-123)^2`: the squared floor of [`determinant_is_noise`]'s precision test. Below the
+/// smallest normal f32 (2^-126) results round to a fixed grid of 2^-149; eight such roundings
+/// stay under one ulp (2^-23 relative) of `u`, `v` and of the hit point as long as the
+/// determinant is at least `2^-149 * 8 / 2^-23 = 2^-123` times `max(1, |d|, |d| / |e|)`.
+const PRECISION_FLOOR_SQ: f64 = 1.0 / (1u128 << 123) as f64 / (1u128 << 123) as f64;
+
+/// True when Moller-Trumbore's f32 determinant `det` (for direction `dir` and edges `e1`, `e2`)
+/// cannot be trusted, so its `u`, `v` and `t` are meaningless:
+/// - within the rounding error of zero, `|det| <= 8 eps |d| |e1| |e2|` (a degenerate triangle,
+///   or a ray in its plane);
+/// - infinite (the products overflowed);
+/// - so small that subnormal rounding would show: below `2^-123 max(1, |d|, |d| / |e|)` for the
+///   longer edge `|e|`, or with `|d| |e2| < 2^-123` (the products that make `d x e2`). In f32
+///   arithmetic this is where triangles under about 1e-12 units (seen along a unit direction)
+///   stop being hit; above it the answers keep their precision.
+///
+/// Compared in f64, where the squared lengths of any finite f32 vectors neither overflow nor
+/// underflow: in f32 they did past `|d| |e1| |e2|` of about 1.8e19 or below about 1e-23, and
+/// rejected every hit on large triangles, along long or short directions, and on triangles
+/// under about 1e-9 units. Shared by the scalar and the 4-wide test, so both decide alike. Runs
+/// only for a hit that passed every other test.
+#[inline]
+pub(crate) fn determinant_is_noise(det: f32, dir: Vec3, e1: Vec3, e2: Vec3) -> bool {
+    let len_sq = |v: Vec3| {
+        let (x, y, z) = (f64::from(v.x), f64::from(v.y), f64::from(v.z));
+        x * x + y * y + z * z
+    };
+    if !det.is_finite() {
+        return true;
+    }
+    let det_sq = f64::from(det) * f64::from(det);
+    let (d, a, b) = (len_sq(dir), len_sq(e1), len_sq(e2));
+    let floor = PRECISION_FLOOR_SQ * 1f64.max(d).max(d / a.max(b));
+    det_sq <= DET_EPSILON_SQ * (d * a * b) || det_sq < floor || d * b < PRECISION_FLOOR_SQ
+}
 
 /// A ray/triangle intersection: the ray parameter and the barycentrics of `v1` and `v2`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -77,8 +113,10 @@ impl Triangle {
     /// - degenerate triangles (zero area, so a zero determinant) and rays in the triangle's plane
     ///   never hit, also when rounding makes the determinant a few ulps from zero (below
     ///   `8 eps |d| |e1| |e2|`, rays within about 1e-6 radians of the plane of a well-shaped
-    ///   triangle); every comparison rejects NaN, and `t` must be finite, so overflow cannot
-    ///   produce a hit either.
+    ///   triangle), or so small that f32's subnormal rounding would show in the answer (triangles
+    ///   under about 1e-12 units seen along a unit direction: see `determinant_is_noise`);
+    ///   every comparison rejects NaN, and the determinant and `t` must be finite, so overflow
+    ///   cannot produce a hit either.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<TriangleHit> {
         let e1 = self.v1 - self.v0;
@@ -108,8 +146,7 @@ impl Triangle {
         // "hit" can lie anywhere, far from the triangle. |det| <= |d| |e1| |e2| always, and its
         // rounding error is a few ulps of that bound, so such hits are rejected. Checked only
         // after everything else passed: hits are rare, misses pay nothing.
-        let bound = ray.dir.length_squared() * e1.length_squared() * e2.length_squared();
-        if det * det <= DET_EPSILON_SQ * bound {
+        if determinant_is_noise(det, ray.dir, e1, e2) {
             return None;
         }
         Some(TriangleHit { t, u, v })
@@ -157,6 +194,69 @@ mod tests {
         assert!(tri().intersect(&r, f32::INFINITY).is_none(), "behind");
         let r = Ray::new(Vec3::new(-1.0, 0.25, 1.0), Vec3::X).unwrap();
         assert!(tri().intersect(&r, f32::INFINITY).is_none(), "in plane");
+    }
+
+    #[test]
+    fn hits_at_every_scale_and_direction_length() {
+        // Found by black-box testing of `rdbvh trace`: the noise check's squared lengths
+        // overflowed or underflowed in f32 and rejected these hits. Scalar and 4-wide agree.
+        use crate::geometry::{RayTri4, Triangle4};
+        let hit = |t: Triangle, r: Ray| {
+            let h = t.intersect(&r, f32::INFINITY);
+            let mut block = Triangle4::EMPTY;
+            block.set(0, &t, 0);
+            let four = block.intersect(&RayTri4::new(&r), f32::INFINITY);
+            assert_eq!(four.mask == 1, h.is_some(), "{t:?} {r:?}");
+            if let Some(h) = h {
+                assert_eq!(four.t[0].to_bits(), h.t.to_bits());
+            }
+            h
+        };
+        let check = |t: Triangle, r: Ray, expect_t: f32| {
+            let h = hit(t, r).unwrap_or_else(|| panic!("{t:?} {r:?}: no hit"));
+            assert!(
+                (h.t - expect_t).abs() <= 1e-5 * expect_t,
+                "{t:?} {r:?}: {h:?}"
+            );
+            assert!(
+                (h.u - 0.25).abs() < 1e-5 && (h.v - 0.5).abs() < 1e-5,
+                "{h:?}"
+            );
+        };
+        let scaled =
+            |scale: f32| Triangle::new(tri().v0 * scale, tri().v1 * scale, tri().v2 * scale);
+        let from = |scale: f32| Vec3::new(0.25, 0.5, 0.0) * scale;
+        for scale in [1e-11f32, 1e-6, 1.0, 1e6, 1e10, 1e12] {
+            check(
+                scaled(scale),
+                Ray::new(from(scale), Vec3::Z).unwrap(),
+                scale,
+            );
+        }
+        // The direction as long as the triangle: the determinant scales with it.
+        for scale in [1e-12f32, 1e-6, 1.0, 1e6, 1e10] {
+            check(
+                scaled(scale),
+                Ray::new(from(scale), Vec3::Z * scale).unwrap(),
+                1.0,
+            );
+        }
+        for len in [1e-30f32, 1e-23, 2e19, 1e20, 1e30] {
+            let r = Ray::new(Vec3::new(0.25, 0.5, 0.0), Vec3::Z * len).unwrap();
+            check(tri(), r, 1.0 / len);
+        }
+        // Past what f32 can compute, no hit rather than a wrong one: a 1e-15 triangle seen along
+        // a unit direction from 1e-15 away gets its `t` numerator on the subnormal grid (it
+        // came out 1.4e-15 for a true 1e-15), and a 1e15 triangle along a 1e15 direction
+        // overflows the determinant.
+        assert_eq!(
+            hit(scaled(1e-15), Ray::new(from(1e-15), Vec3::Z).unwrap()),
+            None
+        );
+        assert_eq!(
+            hit(scaled(1e15), Ray::new(from(1e15), Vec3::Z * 1e15).unwrap()),
+            None
+        );
     }
 
     #[test]

@@ -5,10 +5,10 @@
 use bytemuck::{Pod, Zeroable};
 use wide::f32x4;
 
-use super::{Ray, Triangle};
+use glam::Vec3;
 
-/// `(8 eps)^2`, the same determinant threshold as [`Triangle::intersect`].
-const DET_EPSILON_SQ: f32 = (8.0 * f32::EPSILON) * (8.0 * f32::EPSILON);
+use super::triangle::determinant_is_noise;
+use super::{Ray, Triangle};
 
 /// Four triangles, one per lane: `v0` and the edges `e1 = v1 - v0`, `e2 = v2 - v0` per axis (the
 /// edges are computed once here, with the same single subtraction the scalar test does per ray),
@@ -42,13 +42,13 @@ pub struct Hits4 {
     pub v: [f32; 4],
 }
 
-/// A ray's origin and direction splatted over four lanes, and `|d|^2` for the determinant check,
-/// prepared once per ray.
+/// A ray's origin and direction splatted over four lanes, and the direction itself for the
+/// determinant check, prepared once per ray.
 #[derive(Clone, Copy, Debug)]
 pub struct RayTri4 {
     origin: [f32x4; 3],
     dir: [f32x4; 3],
-    dir_len_sq: f32x4,
+    dir3: Vec3,
     t_min: f32x4,
 }
 
@@ -60,8 +60,7 @@ impl RayTri4 {
         Self {
             origin: [s(ray.origin.x), s(ray.origin.y), s(ray.origin.z)],
             dir: [s(ray.dir.x), s(ray.dir.y), s(ray.dir.z)],
-            // `Vec3::length_squared`: `(x x + y y) + z z`, as the scalar test computes it.
-            dir_len_sq: s(ray.dir.length_squared()),
+            dir3: ray.dir,
             t_min: s(ray.t_min),
         }
     }
@@ -117,7 +116,7 @@ impl Triangle4 {
     /// [`Triangle::intersect`]'s policy and with its exact arithmetic: every product, sum and
     /// comparison in the same order, so a lane is hit exactly when the scalar test hits its
     /// triangle, with the same `t`, `u` and `v`. The scalar test's early exits become masks; the
-    /// determinant-noise check, which needs three more squared lengths, runs only when a lane is
+    /// determinant-noise check (the scalar test's own function, in f64) runs only for the lanes
     /// still hit.
     #[inline(always)]
     pub fn intersect(&self, ray: &RayTri4, t_max: f32) -> Hits4 {
@@ -149,10 +148,14 @@ impl Triangle4 {
             & t.abs().simd_lt(f32x4::splat(f32::INFINITY));
         let mut mask = ok.to_bitmask();
         if mask != 0 {
-            // `|d|^2 |e1|^2 |e2|^2`, multiplied left to right as the scalar test does.
-            let bound = ray.dir_len_sq * dot(e1, e1) * dot(e2, e2);
-            let noise = (det * det).simd_le(f32x4::splat(DET_EPSILON_SQ) * bound);
-            mask &= !noise.to_bitmask();
+            let edge = |e: &[[f32; 4]; 3], j: usize| Vec3::new(e[0][j], e[1][j], e[2][j]);
+            for (j, &det) in det.to_array().iter().enumerate() {
+                if mask & (1 << j) != 0
+                    && determinant_is_noise(det, ray.dir3, edge(&self.e1, j), edge(&self.e2, j))
+                {
+                    mask &= !(1 << j);
+                }
+            }
         }
         Hits4 {
             mask,

@@ -20,6 +20,18 @@ pub enum VertexKind {
     Normal,
 }
 
+impl VertexKind {
+    /// `n` of this kind, in words: "1 vertex", "2 vertices".
+    fn count(self, n: usize) -> String {
+        let (one, many) = match self {
+            VertexKind::Position => ("vertex", "vertices"),
+            VertexKind::TexCoord => ("texture coordinate", "texture coordinates"),
+            VertexKind::Normal => ("normal", "normals"),
+        };
+        format!("{n} {}", if n == 1 { one } else { many })
+    }
+}
+
 impl fmt::Display for VertexKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
@@ -104,9 +116,10 @@ impl fmt::Display for SceneError {
                 defined,
             } => write!(
                 f,
-                "{} line {line}: face refers to {kind} {index}, but only {defined} {kind}s are \
-                 defined before it",
-                path.display()
+                "{} line {line}: face refers to {kind} {index}, but only {} {} defined before it",
+                path.display(),
+                kind.count(*defined),
+                if *defined == 1 { "is" } else { "are" }
             ),
             SceneError::NoTriangles { path } => {
                 write!(

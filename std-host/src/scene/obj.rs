@@ -7,6 +7,13 @@
 //! Checking every face index against the vertices defined before it makes those inputs a clear
 //! [`SceneError::MissingVertex`] instead. The same pass skips polylines (`tobj` reads `l a b c` as a
 //! triangle) and rejects MTL colour lines with fewer than three values (`tobj` panics on them).
+//! It also checks every `v`, `vt` and `vn` line as `tobj` will parse it, so a malformed number is
+//! an error with its line too. Before either reads it, the text loses a UTF-8 byte-order mark
+//! (which `tobj` would take as part of the first statement: the first vertex was silently
+//! dropped) and any trailing `# comment` on a data line (`tobj` reads it as more numbers or
+//! indices).
+
+use std::borrow::Cow;
 
 use std::cell::RefCell;
 use std::collections::HashSet;
@@ -108,11 +115,10 @@ impl Scene {
         label: &Path,
         materials: MaterialFiles<'_>,
     ) -> Result<Scene, SceneError> {
-        let check = check_obj(text, label)?;
-        let sanitized;
-        let text = if check.has_polylines {
-            sanitized = without_polylines(text);
-            sanitized.as_str()
+        let text = normalized(text);
+        let check = check_obj(&text, label)?;
+        let text = if check.has_polylines || check.mixed_colours {
+            Cow::Owned(sanitized(&text, &check))
         } else {
             text
         };
@@ -235,14 +241,81 @@ fn check_finite(triangles: &[Triangle], label: &Path) -> Result<(), SceneError> 
 struct ObjCheck {
     /// `l` lines present (to be hidden from `tobj`).
     has_polylines: bool,
+    /// Some positions carry an RGB colour and some do not: `tobj` then fails on the faces
+    /// ("face vertex color index out of bounds"), so the colours (unused here) are dropped.
+    mixed_colours: bool,
     /// Points, polylines and faces with fewer than 3 vertices.
     skipped: usize,
     /// Material names given to `usemtl`, first use first.
     used_materials: Vec<String>,
 }
 
+/// Statements whose words are all numbers or indices, so a `#` in them can only start a comment.
+const DATA_STATEMENTS: [&str; 7] = ["v", "vt", "vn", "vp", "f", "l", "p"];
+
+/// The text as the checks and `tobj` read it: without a leading UTF-8 byte-order mark, and with
+/// a trailing `# comment` cut from every data line ([`DATA_STATEMENTS`]); other lines (names of
+/// materials, groups, libraries) are kept whole. Borrowed when nothing changes.
+fn normalized(text: &str) -> Cow<'_, str> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let is_data = |line: &str| {
+        line.split_whitespace()
+            .next()
+            .is_some_and(|w| DATA_STATEMENTS.contains(&w))
+    };
+    if !text.lines().any(|line| line.contains('#') && is_data(line)) {
+        return Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len());
+    for line in text.lines() {
+        match line.find('#') {
+            Some(at) if is_data(line) => out.push_str(&line[..at]),
+            _ => out.push_str(line),
+        }
+        out.push('\n');
+    }
+    Cow::Owned(out)
+}
+
+/// Checks a `v`, `vt` or `vn` line's numbers (`words`, after the statement) as `tobj` parses
+/// them: `count` numbers first (x y z; u v; x y z); a position may add a weight `w` (not zero:
+/// `tobj` divides by it) or an RGB colour.
+fn check_numbers<'a>(
+    mut words: impl Iterator<Item = &'a str>,
+    count: usize,
+    what: &str,
+) -> Result<(), String> {
+    let number = |w: &str, name: &str| {
+        w.parse::<f32>()
+            .map_err(|_| format!("{what}: {name} '{w}' is not a number"))
+    };
+    for k in 0..count {
+        let Some(w) = words.next() else {
+            return Err(format!("{what} needs {count} numbers, found {k}"));
+        };
+        number(w, "coordinate")?;
+    }
+    if what != "position" {
+        return Ok(());
+    }
+    let rest: Vec<&str> = words.collect();
+    match rest.as_slice() {
+        [] => Ok(()),
+        [w] if number(w, "weight")? == 0.0 => Err(format!("{what}: weight w is 0")),
+        [_] => Ok(()),
+        [r, g, b] => [r, g, b]
+            .into_iter()
+            .try_for_each(|c| number(c, "colour component").map(|_| ())),
+        more => Err(format!(
+            "{what} has {} numbers: expected 3, 4 (with a weight) or 6 (with a colour)",
+            3 + more.len()
+        )),
+    }
+}
+
 /// Checks every face index against the positions, texture coordinates and normals defined before
-/// the face (the OBJ rule, and what `tobj` resolves relative indices against), and every `usemtl`.
+/// the face (the OBJ rule, and what `tobj` resolves relative indices against), every `usemtl`,
+/// and the numbers of every `v`, `vt` and `vn` line.
 fn check_obj(text: &str, label: &Path) -> Result<ObjCheck, SceneError> {
     let malformed = |line: usize, reason: String| SceneError::Malformed {
         path: label.to_path_buf(),
@@ -253,6 +326,8 @@ fn check_obj(text: &str, label: &Path) -> Result<ObjCheck, SceneError> {
     let mut seen_materials = HashSet::new();
     // Positions, texture coordinates, normals defined so far.
     let mut defined = [0usize; 3];
+    // Whether some position has no colour, and whether some has one.
+    let mut colours = [false; 2];
     const KINDS: [VertexKind; 3] = [
         VertexKind::Position,
         VertexKind::TexCoord,
@@ -261,10 +336,23 @@ fn check_obj(text: &str, label: &Path) -> Result<ObjCheck, SceneError> {
     for (i, line) in text.lines().enumerate() {
         let number = i + 1;
         let mut words = line.split_whitespace();
-        match words.next() {
-            Some("v") => defined[0] += 1,
-            Some("vt") => defined[1] += 1,
-            Some("vn") => defined[2] += 1,
+        let statement = words.next();
+        let numbers = match statement {
+            Some("v") => Some((0, 3, "position")),
+            Some("vt") => Some((1, 2, "texture coordinate")),
+            Some("vn") => Some((2, 3, "normal")),
+            _ => None,
+        };
+        if let Some((kind, count, what)) = numbers {
+            if kind == 0 {
+                // `check_numbers` accepts 3, 4 or 6 numbers; 6 is a colour.
+                let coloured = line.split_whitespace().count() == 7;
+                colours[usize::from(coloured)] = true;
+            }
+            check_numbers(words.by_ref(), count, what).map_err(|e| malformed(number, e))?;
+            defined[kind] += 1;
+        }
+        match statement {
             Some("l") => {
                 check.has_polylines = true;
                 check.skipped += 1;
@@ -325,15 +413,30 @@ fn check_obj(text: &str, label: &Path) -> Result<ObjCheck, SceneError> {
             _ => {}
         }
     }
+    check.mixed_colours = colours == [true; 2];
     Ok(check)
 }
 
-/// The text with every `l` line blanked (kept as an empty line so line numbers stay the same).
-fn without_polylines(text: &str) -> String {
+/// The text as `tobj` should read it after the check: every `l` line blanked (kept as an empty
+/// line so line numbers stay the same) and, when only some positions carry a colour, every `v`
+/// line cut to its coordinates and weight.
+fn sanitized(text: &str, check: &ObjCheck) -> String {
     let mut out = String::with_capacity(text.len());
     for line in text.lines() {
-        if line.split_whitespace().next() != Some("l") {
-            out.push_str(line);
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("l") => {}
+            Some("v") if check.mixed_colours => {
+                let numbers: Vec<&str> = words.collect();
+                out.push('v');
+                // 3 coordinates, or 3 and a weight; a colour's three numbers go.
+                let keep = if numbers.len() == 4 { 4 } else { 3 };
+                for n in &numbers[..keep] {
+                    out.push(' ');
+                    out.push_str(n);
+                }
+            }
+            _ => out.push_str(line),
         }
         out.push('\n');
     }
@@ -482,10 +585,57 @@ mod tests {
     }
 
     #[test]
-    fn tobj_parse_errors_are_malformed() {
-        let e = err("v 0 0\nf 1 1 1\n");
-        assert!(matches!(e, SceneError::Malformed { line: None, .. }), "{e}");
-        assert!(e.to_string().contains(MEMORY_LABEL));
+    fn malformed_vertex_lines_name_the_line() {
+        for (text, says) in [
+            ("v 0 0\n", "position needs 3 numbers, found 2"),
+            ("v 0 x 0\n", "'x' is not a number"),
+            ("v 0 0 0 0\n", "weight w is 0"),
+            ("v 0 0 0 1 1\n", "has 5 numbers"),
+            ("v 0 0 0 1 1 z\n", "colour component 'z'"),
+            ("vt 0\n", "texture coordinate needs 2 numbers, found 1"),
+            ("vn 0 0 abc\n", "normal: coordinate 'abc'"),
+        ] {
+            let text = format!("v 0 0 0\nv 1 0 0\n{text}v 0 1 0\nf 1 2 4\n");
+            match err(&text) {
+                SceneError::Malformed {
+                    line: Some(3),
+                    reason,
+                    ..
+                } if reason.contains(says) => {}
+                e => panic!("{text:?}: unexpected {e}"),
+            }
+        }
+        assert!(err("v 0 0\n").to_string().contains(MEMORY_LABEL));
+        // What `tobj` reads and the check accepts: a weight, a colour (on some vertices only:
+        // `tobj` fails on that, so the colours are dropped), a third texture coordinate.
+        let s = Scene::from_obj_str("v 0 0 0 2\nv 1 0 0 0.5 0.5 0.5\nvt 0 0 0\nv 0 1 0\nf 1 2 3\n")
+            .unwrap();
+        assert_eq!(s.triangles[0].v1, Vec3::X);
+    }
+
+    #[test]
+    fn a_byte_order_mark_and_trailing_comments_are_not_data() {
+        // Found by black-box testing: a BOM glued to the first `v` made `tobj` skip that vertex,
+        // so every face index silently shifted by one.
+        let s = Scene::from_obj_str(&format!("\u{feff}{QUAD}")).unwrap();
+        assert_eq!(s.triangles, Scene::from_obj_str(QUAD).unwrap().triangles);
+        let commented = "v 0 0 0 # origin\nv 1 0 0\nv 0 1 0#tight\nusemtl a#b\nf 1 2 3 # one\n";
+        let s = Scene::from_obj_str(commented).unwrap();
+        assert_eq!(s.triangles[0].v2, Vec3::Y);
+        // Names keep their `#`.
+        assert!(
+            s.warnings.iter().any(|w| w.to_string().contains("a#b")),
+            "{:?}",
+            s.warnings
+        );
+    }
+
+    #[test]
+    fn missing_vertex_messages_count_in_words() {
+        let e = err("v 0 0 0\nf 1 1 2\n").to_string();
+        assert!(e.contains("only 1 vertex is defined before it"), "{e}");
+        let e = err("v 0 0 0\nv 0 0 0\nf 1 2 3\n").to_string();
+        assert!(e.contains("only 2 vertices are defined before it"), "{e}");
     }
 
     #[test]

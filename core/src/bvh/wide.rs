@@ -108,7 +108,9 @@ impl WideBvh {
             return out;
         }
         out.nodes.push(WideNode::UNUSED);
-        if is_wide_leaf(bvh, 0) {
+        let sizes = subtree_sizes(bvh);
+        let is_wide_leaf = |b: u32| is_wide_leaf(bvh, &sizes, b);
+        if is_wide_leaf(0) {
             out.push_leaf(0, 0, bvh, 0, tris);
             return out;
         }
@@ -122,7 +124,7 @@ impl WideBvh {
             let node = &bvh.nodes[binary as usize];
             for (i, slot) in open[..2].iter_mut().enumerate() {
                 let b = node.left_first + i as u32;
-                *slot = (b, is_wide_leaf(bvh, b));
+                *slot = (b, is_wide_leaf(b));
             }
             let mut n = 2;
             while n < 4 {
@@ -132,8 +134,8 @@ impl WideBvh {
                 });
                 let Some(i) = pick else { break };
                 let l = bvh.nodes[open[i].0 as usize].left_first;
-                open[i] = (l, is_wide_leaf(bvh, l));
-                open[n] = (l + 1, is_wide_leaf(bvh, l + 1));
+                open[i] = (l, is_wide_leaf(l));
+                open[n] = (l + 1, is_wide_leaf(l + 1));
                 n += 1;
             }
             for (slot, &(b, leaf)) in open[..n].iter().enumerate() {
@@ -211,23 +213,52 @@ impl WideBvh {
     }
 }
 
+/// Primitives in each binary node's subtree, saturated at `LEAF_BLOCK + 1` ("more than a
+/// leaf's two blocks"): one post-order pass, so deciding whether a node becomes a wide leaf
+/// costs a lookup instead of a walk of its subtree (the collapse asks it of every node it opens,
+/// and each answer's merge ratio asks it of both children again).
+fn subtree_sizes(bvh: &Bvh) -> Vec<u8> {
+    const MORE: u8 = LEAF_BLOCK as u8 + 1;
+    let mut sizes = alloc::vec![0u8; bvh.nodes.len()];
+    // (node, whether its children are done); a valid tree's depth bounds the stack.
+    let mut stack: Vec<(u32, bool)> = Vec::with_capacity(2 * MAX_DEPTH as usize + 2);
+    stack.push((0, false));
+    while let Some((b, done)) = stack.pop() {
+        let node = &bvh.nodes[b as usize];
+        if node.is_leaf() {
+            sizes[b as usize] = node.count.min(u32::from(MORE)) as u8;
+        } else if done {
+            let l = node.left_first as usize;
+            sizes[b as usize] = (sizes[l] + sizes[l + 1]).min(MORE);
+        } else {
+            stack.push((b, true));
+            stack.push((node.left_first + 1, false));
+            stack.push((node.left_first, false));
+        }
+    }
+    sizes
+}
+
 /// True when binary node `b` becomes a leaf of the wide tree: a binary leaf, a subtree of at most
 /// four triangles, or one of at most [`LEAF_BLOCK`] that [`MERGE_RATIO`] says not to split.
-fn is_wide_leaf(bvh: &Bvh, b: u32) -> bool {
+/// `sizes` is [`subtree_sizes`]'s.
+fn is_wide_leaf(bvh: &Bvh, sizes: &[u8], b: u32) -> bool {
     let node = &bvh.nodes[b as usize];
     if node.is_leaf() {
         return true;
     }
-    let Some((_, n)) = small_subtree(bvh, b) else {
+    let n = usize::from(sizes[b as usize]);
+    if n > LEAF_BLOCK {
         return false;
-    };
+    }
     if n <= 4 {
         return true;
     }
-    // Blocks a ray entering child `c` tests, weighted by the chance that it enters.
+    // Blocks a ray entering child `c` tests, weighted by the chance that it enters (a child of
+    // a subtree of at most LEAF_BLOCK primitives holds at most that many itself).
     let blocks = |c: u32| {
-        let m = small_subtree(bvh, c).map_or(LEAF_BLOCK, |(_, m)| m);
-        m.div_ceil(4) as f32 * bvh.nodes[c as usize].bounds().half_area()
+        usize::from(sizes[c as usize]).div_ceil(4) as f32
+            * bvh.nodes[c as usize].bounds().half_area()
     };
     let l = node.left_first;
     blocks(l) + blocks(l + 1) >= MERGE_RATIO * n.div_ceil(4) as f32 * node.bounds().half_area()

@@ -6,7 +6,8 @@
 //! over the threaded build's) and whether the threaded tree equals the single-threaded one.
 //!
 //! `RDBVH_PROFILE_PAH=1` adds the `full` preset (PAH + SPFH) over the `peers` table's plane and
-//! point areas: CPU time, its ratio to the SAH build's, and the tree's hash.
+//! point areas: CPU time, its ratio to the SAH build's, and the tree's hash; `plane` or `point`
+//! instead of `1` builds over that area alone (for `--toggle-collect=build_profile::pah_once`).
 //!
 //! Under `valgrind --tool=callgrind --toggle-collect=build_profile::build_once`, only the builds
 //! (loading the triangle bounds included) are counted; `RDBVH_PROFILE_MT=0` skips the threaded
@@ -35,6 +36,15 @@ fn build_once(tris: &[Triangle]) -> Bvh {
 #[inline(never)]
 fn build_mt_once(tris: &[Triangle]) -> Bvh {
     rdbvh::parallel::build(&Builder::sah(), black_box(tris)).expect("finite scene")
+}
+
+/// One timed `full` build over `area`: loading the bounds and the preset's build.
+#[inline(never)]
+fn pah_once(tris: &[Triangle], area: &InfluenceArea, arena: &mut BuildArena, out: &mut Bvh) {
+    arena.load_triangles(black_box(tris)).expect("finite");
+    Preset::Full
+        .build_into(Some(area), &PresetOptions::default(), arena, out)
+        .expect("pah build");
 }
 
 fn tree_hash(bvh: &Bvh) -> u64 {
@@ -103,7 +113,8 @@ fn main() -> ExitCode {
         bvh.nodes().len()
     );
     // PAH: the `full` preset (PAH + SPFH) with the plane and point areas the `peers` table uses.
-    if std::env::var("RDBVH_PROFILE_PAH").is_ok_and(|v| v == "1") {
+    let pah = std::env::var("RDBVH_PROFILE_PAH").unwrap_or_default();
+    if ["1", "plane", "point"].contains(&pah.as_str()) {
         let b = tris.iter().fold(rdbvh_core::geometry::Aabb::EMPTY, |b, t| {
             b.union(t.bounds())
         });
@@ -111,16 +122,13 @@ fn main() -> ExitCode {
             ("plane", plane_area_over(&b).expect("plane").into()),
             ("point", point_area_over(&b).expect("point").into()),
         ];
-        for (name, area) in &areas {
+        for (name, area) in areas.iter().filter(|(name, _)| pah == "1" || pah == *name) {
             let mut arena = BuildArena::with_capacity(n);
             let mut out = Bvh::with_capacity(n);
             let mut best_pah = f64::INFINITY;
             for _ in 0..reps {
                 let t = thread_cpu_seconds();
-                arena.load_triangles(&tris).expect("finite");
-                Preset::Full
-                    .build_into(Some(area), &PresetOptions::default(), &mut arena, &mut out)
-                    .expect("pah build");
+                pah_once(&tris, area, &mut arena, &mut out);
                 best_pah = best_pah.min(thread_cpu_seconds() - t);
             }
             println!(

@@ -82,6 +82,8 @@ fn bad_scenes_are_one_line_errors() {
             "v 0 0 inf\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".into(),
             "NaN or infinite",
         ),
+        ("badv.obj", "v 0 0 0\nv 1 x 0\n".into(), "line 2"),
+        ("badvt.obj", format!("{tri}vt 0\nf 1 2 3\n"), "line 4"),
     ] {
         let path = dir.join(name);
         std::fs::write(&path, text).unwrap();
@@ -191,4 +193,49 @@ fn bad_areas_are_one_line_errors() {
             needle,
         );
     }
+}
+
+#[test]
+fn a_bom_is_not_part_of_the_first_vertex_and_an_experiment_checks_its_folder_first() {
+    let Some(bin) = binary() else { return };
+    let dir = scratch("bom");
+    // Found by black-box testing: the BOM made the first vertex vanish and shifted every index.
+    let obj = dir.join("bom.obj");
+    std::fs::write(
+        &obj,
+        "\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 5 5\nf 1 2 3 # comment\n",
+    )
+    .unwrap();
+    let rays = dir.join("rays.csv");
+    std::fs::write(&rays, "ox,oy,oz,dx,dy,dz\n0.2,0.2,-1,0,0,1\n").unwrap();
+    let hits = dir.join("hits.csv");
+    let out = Command::new(&bin)
+        .args(["trace", obj.to_str().unwrap(), "--rays"])
+        .args([rays.to_str().unwrap(), "--out", hits.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&hits).unwrap();
+    assert_eq!(text.lines().nth(1), Some("0,1,0,0.2,0.2"), "{text}");
+    // An --out that names a file fails before any run, with words for it.
+    let file = dir.join("taken");
+    std::fs::write(&file, "").unwrap();
+    let experiment = dir.join("e.toml");
+    std::fs::write(
+        &experiment,
+        "[settings]\nrays_per_config = 10\n[[config]]\nfile = \"bom.obj\"\nkind = \"plane\"\n\
+         center = [0.2, 0.2, -1.0]\nnormal = [0.0, 0.0, 1.0]\nhalf_width = 1.0\n\
+         half_height = 1.0\ndepth = 3.0\n",
+    )
+    .unwrap();
+    let e = experiment.to_str().unwrap();
+    fails(
+        &bin,
+        &["experiment", e, "--out", file.to_str().unwrap()],
+        "not a folder",
+    );
 }

@@ -62,7 +62,7 @@ pub struct AnalyzeArgs {
     /// CSV columns for --nodes, comma-separated (default: all of index, parent, depth, min_x,
     /// min_y, min_z, max_x, max_y, max_z, count, left_first, measure, hit_probability, is_leaf,
     /// area).
-    #[arg(long, value_name = "a,b", value_delimiter = ',')]
+    #[arg(long, value_name = "a,b", value_delimiter = ',', requires = "nodes")]
     pub columns: Option<Vec<String>>,
 }
 

@@ -108,8 +108,8 @@ pub fn run(out: &mut impl Write) -> Result<(), CliError> {
         out,
         format!(
             "\nall {checked} queries agree with brute force on both builders and through the \
-             scene structure, on {} threads",
-            rayon::current_num_threads()
+             scene structure, on {}",
+            super::count(rayon::current_num_threads(), "thread")
         ),
     )
 }

@@ -117,6 +117,11 @@ fn usage_error(e: &clap::Error) -> ExitCode {
     }
 }
 
+/// `n` things in words: "1 thread", "2 threads".
+fn count(n: usize, thing: &str) -> String {
+    format!("{n} {thing}{}", if n == 1 { "" } else { "s" })
+}
+
 /// clap's message without its usage block, on one line.
 fn one_line(message: &str) -> String {
     let body = message.split("\nUsage:").next().unwrap_or(message);

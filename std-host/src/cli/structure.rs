@@ -234,11 +234,11 @@ fn finish<L: AreaLookup + Sync>(
     };
     let lines = [
         format!(
-            "traced {n} rays ({kind}) against {} triangles through {areas} influence area{} with \
-             {} threads: {} hits, {:.3} ms, {:.0} rays/s",
-            scene.len(),
-            if areas == 1 { "" } else { "s" },
-            rayon::current_num_threads(),
+            "traced {} ({kind}) against {} through {} with {}: {} hits, {:.3} ms, {:.0} rays/s",
+            super::count(n, "ray"),
+            super::count(scene.len(), "triangle"),
+            super::count(areas, "influence area"),
+            super::count(rayon::current_num_threads(), "thread"),
             t.answers.hits(),
             t.seconds * 1e3,
             per_second(t.seconds)

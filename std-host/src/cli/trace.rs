@@ -82,14 +82,19 @@ impl Answers {
     }
 
     /// Writes the answers as CSV. Floats use Rust's shortest round-trip formatting, so reading
-    /// them back as `f32` gives the same bits.
+    /// them back as `f32` gives the same bits, except that a negative zero (a barycentric on an
+    /// edge, rounded from the wrong side) is written `0`, not `-0`.
     pub fn write_csv(&self, out: &mut impl Write) -> std::io::Result<()> {
         match self {
             Answers::Closest(hits) => {
                 writeln!(out, "ray,t,triangle,u,v")?;
                 for (i, hit) in hits.iter().enumerate() {
                     match hit {
-                        Some(h) => writeln!(out, "{i},{},{},{},{}", h.t, h.triangle, h.u, h.v)?,
+                        Some(h) => {
+                            // `x + 0.0` is `x` for every float except -0, which becomes +0.
+                            let (t, u, v) = (h.t + 0.0, h.u + 0.0, h.v + 0.0);
+                            writeln!(out, "{i},{t},{},{u},{v}", h.triangle)?
+                        }
                         None => writeln!(out, "{i},,,,")?,
                     }
                 }
@@ -157,11 +162,10 @@ pub fn run(args: &TraceArgs, log: &mut impl Write) -> Result<(), CliError> {
     };
     writeln!(
         log,
-        "traced {} rays ({kind}) against {} triangles with {} threads: {} hits, {:.3} ms, \
-         {:.0} rays/s",
-        rays.len(),
-        scene.len(),
-        rayon::current_num_threads(),
+        "traced {} ({kind}) against {} with {}: {} hits, {:.3} ms, {:.0} rays/s",
+        super::count(rays.len(), "ray"),
+        super::count(scene.len(), "triangle"),
+        super::count(rayon::current_num_threads(), "thread"),
         answers.hits(),
         seconds * 1e3,
         per_second
@@ -202,6 +206,15 @@ mod tests {
         let line = text.lines().nth(1).unwrap();
         let v: f32 = line.rsplit(',').next().unwrap().parse().unwrap();
         assert_eq!(v, 1e-8);
+        // A barycentric rounded to -0 on an edge is written 0.
+        let edge = Hit { u: -0.0, ..hit };
+        let mut out = Vec::new();
+        Answers::Closest(vec![Some(edge)])
+            .write_csv(&mut out)
+            .unwrap();
+        assert!(String::from_utf8(out)
+            .unwrap()
+            .ends_with("\n0,0.1,3,0,0.00000001\n"));
 
         let mut out = Vec::new();
         Answers::Any(vec![false, true]).write_csv(&mut out).unwrap();

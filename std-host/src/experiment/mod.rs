@@ -184,6 +184,17 @@ pub fn run_experiment(
             "octree_levels must be at least 1".into(),
         ));
     }
+    // The output folder first: a path that cannot be one fails before the runs, not after.
+    if opts.out.exists() && !opts.out.is_dir() {
+        return Err(ExperimentError::Io(
+            opts.out.clone(),
+            "exists and is not a folder (--out names the folder for results.csv, report.md and \
+             the charts)"
+                .into(),
+        ));
+    }
+    std::fs::create_dir_all(&opts.out)
+        .map_err(|e| ExperimentError::Io(opts.out.clone(), e.to_string()))?;
     let local = settings.preset_options(opts.thesis_mode);
     let setup = RunSetup {
         local,
@@ -240,7 +251,7 @@ pub fn run_experiment(
         .par_iter()
         .map(|p| {
             let scene = Scene::open(&p.to_string_lossy())
-                .map_err(|e| ExperimentError::Scene(format!("{}: {e}", p.display())))?;
+                .map_err(|e| ExperimentError::Scene(e.to_string()))?;
             let fallback = build_fallback(&scene.triangles, &setup)?;
             Ok((p.clone(), Arc::new(scene), Arc::new(fallback)))
         })
@@ -317,8 +328,6 @@ pub fn run_experiment(
     rows.sort_by_key(|(i, p, _)| (*i, *p));
     let rows: Vec<RunRow> = rows.into_iter().map(|(_, _, r)| r).collect();
 
-    std::fs::create_dir_all(&opts.out)
-        .map_err(|e| ExperimentError::Io(opts.out.clone(), e.to_string()))?;
     let results = opts.out.join("results.csv");
     results::write_results(&results, &rows)?;
 

@@ -7,7 +7,7 @@ use rdbvh_core::heuristics::CostConstants;
 use serde::Deserialize;
 
 use super::ExperimentError;
-use crate::areas::{parse_areas, AreaEntry};
+use crate::areas::{parse_areas, AreaEntry, AreasErrorKind};
 
 /// `[settings]`: every key is optional. `rays_per_config` and `heuristics` apply in every mode;
 /// the builder keys apply only with `--thesis-mode` (without it the project's binned builder runs
@@ -161,13 +161,26 @@ impl ExperimentFile {
     /// Parses an experiment file's text; `path` locates `scene_dir` and labels errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self, ExperimentError> {
         let top: Top = toml::from_str(text).map_err(|e| {
+            // The line of the offending key or value, when the parser says where it is.
+            let line = e
+                .span()
+                .map(|at| format!(" line {}", text[..at.start].matches('\n').count() + 1))
+                .unwrap_or_default();
             ExperimentError::Settings(format!(
-                "{}: {}",
+                "{}{line}: {}",
                 path.display(),
                 e.message().lines().next().unwrap_or("invalid TOML")
             ))
         })?;
-        let areas = parse_areas(text, path).map_err(|e| ExperimentError::Areas(e.to_string()))?;
+        let areas = parse_areas(text, path).map_err(|e| match e.kind {
+            // The area files' wording names [[area]] tables first; an experiment lists configs.
+            AreasErrorKind::NoAreas => ExperimentError::Areas(format!(
+                "{}: no configurations: list each as a [[config]] table with kind = \"plane\" or \
+                 \"point\", as in the thesis's experiments.toml",
+                path.display()
+            )),
+            _ => ExperimentError::Areas(e.to_string()),
+        })?;
         let base = path.parent().unwrap_or(Path::new("."));
         let scene_dir = match top.scene_dir {
             Some(d) => base.join(d),
@@ -196,6 +209,9 @@ mod tests {
         let bad = format!("[settings]\nrays_per_confg = 3\n{text}");
         let e = ExperimentFile::parse(&bad, Path::new("e.toml")).unwrap_err();
         assert!(e.to_string().contains("rays_per_confg"), "{e}");
+        assert!(e.to_string().starts_with("e.toml line 2: "), "{e}");
+        let e = ExperimentFile::parse("[settings]\n", Path::new("e.toml")).unwrap_err();
+        assert!(e.to_string().contains("no configurations"), "{e}");
         assert!(parse_presets(["full", "bogus"]).is_err());
         assert_eq!(
             parse_presets(["Full", "full", "standard"]).unwrap(),

@@ -75,14 +75,14 @@ pub fn build() -> String {
 pub fn trace() -> String {
     format!(
         "Without --areas, one BVH over the scene answers every ray (--builder, or --preset sah or\n\
-         standard), traversed as its 4-wide collapse (same answers, faster). With --areas, rays are answered through the scene structure: an octree (or a\n\
-         list) finds the areas that may contain a ray's origin; a ray affine to one (origin inside,\n\
-         direction within 1 degree of the area's) searches that area's local BVH (built with\n\
-         --preset, default full) up to where it leaves the area, and otherwise the fallback BVH\n\
-         (binned SAH over the whole scene, default settings) answers. The answers equal brute force\n\
-         either way. Standard error then gets the local hit rate, the mean cost per ray\n\
-         (C_trav = C_isect = 1) with the structure and with the fallback BVH alone on the same rays,\n\
-         and rays per second.\n\n\
+         standard), traversed as its 4-wide collapse (same answers, faster). With --areas, rays are\n\
+         answered through the scene structure: an octree (or a list) finds the areas that may\n\
+         contain a ray's origin; a ray affine to one (origin inside, direction within 1 degree of\n\
+         the area's) searches that area's local BVH (built with --preset, default full) up to where\n\
+         it leaves the area, and otherwise the fallback BVH (binned SAH over the whole scene,\n\
+         default settings) answers. The answers equal brute force either way. Standard error then\n\
+         gets the local hit rate, the mean cost per ray (C_trav = C_isect = 1) with the structure\n\
+         and with the fallback BVH alone on the same rays, and rays per second.\n\n\
          {PRESETS}\n\n\
          {AREAS}\n\n\
          Examples:\n  \

@@ -193,6 +193,42 @@ fn bad_areas_are_one_line_errors() {
             needle,
         );
     }
+    // An option the chosen lookup would ignore is refused, not ignored.
+    let areas = dir.join("ok.toml");
+    std::fs::write(&areas, plane("1.0")).unwrap();
+    let rays = dir.join("rays.csv");
+    std::fs::write(&rays, "ox,oy,oz,dx,dy,dz\n5,9,5,0,-1,0\n").unwrap();
+    let (a, r, o) = (
+        areas.to_str().unwrap(),
+        rays.to_str().unwrap(),
+        dir.join("hits.csv"),
+    );
+    let o = o.to_str().unwrap();
+    let args = [
+        "trace",
+        "builtin:room",
+        "--areas",
+        a,
+        "--rays",
+        r,
+        "--out",
+        o,
+    ];
+    fails(
+        &bin,
+        &[&args[..], &["--lookup", "list", "--octree-levels", "4"]].concat(),
+        "--octree-levels",
+    );
+    let out = Command::new(&bin)
+        .args(args)
+        .args(["--octree-levels", "4"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]

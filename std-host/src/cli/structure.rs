@@ -11,7 +11,9 @@ use rdbvh_core::build::{Preset, PresetOptions, ReinsertConfig};
 use rdbvh_core::bvh::{Bvh, TraversalStats};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::CostConstants;
-use rdbvh_core::toplevel::{AreaLookup, Scene as Structure, SceneOptions, SceneStats};
+use rdbvh_core::toplevel::{
+    AreaLookup, Scene as Structure, SceneOptions, SceneStats, DEFAULT_OCTREE_LEVELS,
+};
 
 use super::areas::load_areas;
 use super::rays::read_rays;
@@ -173,6 +175,11 @@ pub fn run(args: &TraceArgs, areas_path: &Path, log: &mut impl Write) -> Result<
                 .into(),
         ));
     }
+    if args.lookup == LookupKind::List && args.octree_levels.is_some() {
+        return Err(CliError::Usage(
+            "--octree-levels sizes the octree lookup; --lookup list has no levels".into(),
+        ));
+    }
     let (scene, _) = load_scene(&args.scene)?;
     let entries = load_areas(areas_path, &scene)?;
     let rays = read_rays(&args.rays)?;
@@ -182,12 +189,13 @@ pub fn run(args: &TraceArgs, areas_path: &Path, log: &mut impl Write) -> Result<
     let start = Instant::now();
     match args.lookup {
         LookupKind::Octree => {
-            let s = Structure::with_octree(&scene.triangles, areas, &options, args.octree_levels)?;
+            let levels = args.octree_levels.unwrap_or(DEFAULT_OCTREE_LEVELS);
+            let s = Structure::with_octree(&scene.triangles, areas, &options, levels)?;
             let build_seconds = start.elapsed().as_secs_f64();
             let o = s.lookup().stats();
             let lookup = format!(
-                "octree of {} levels ({} used, {} nodes, {} leaves)",
-                args.octree_levels, o.levels, o.nodes, o.leaves
+                "octree of {levels} levels ({} used, {} nodes, {} leaves)",
+                o.levels, o.nodes, o.leaves
             );
             finish(args, &scene, &rays, &s, &lookup, build_seconds, log)
         }

@@ -11,7 +11,7 @@ use clap::{value_parser, Args, ValueEnum};
 use rayon::prelude::*;
 use rdbvh_core::bvh::{Hit, Traversable, WideBvh};
 use rdbvh_core::geometry::{Ray, Triangle};
-use rdbvh_core::toplevel::{DEFAULT_OCTREE_LEVELS, MAX_OCTREE_LEVELS};
+use rdbvh_core::toplevel::MAX_OCTREE_LEVELS;
 
 use super::builder::BuilderArgs;
 use super::rays::read_rays;
@@ -53,10 +53,10 @@ pub struct TraceArgs {
     /// With --areas: how a ray's origin finds its candidate areas.
     #[arg(long, value_enum, default_value_t = LookupKind::Octree, requires = "areas")]
     pub lookup: LookupKind,
-    /// With --areas and the octree lookup: its maximum number of levels.
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_OCTREE_LEVELS, requires = "areas",
+    /// With --areas and the octree lookup: its maximum number of levels [default: 5]
+    #[arg(long, value_name = "N", requires = "areas",
           value_parser = value_parser!(u32).range(1..=i64::from(MAX_OCTREE_LEVELS)))]
-    pub octree_levels: u32,
+    pub octree_levels: Option<u32>,
     /// With --areas: how many affine areas a ray tries before the fallback BVH.
     #[arg(long, value_name = "K", default_value_t = 1, requires = "areas",
           value_parser = value_parser!(u32).range(1..))]
@@ -188,6 +188,13 @@ pub(super) fn write_answers(path: &Path, answers: &Answers) -> Result<(), CliErr
 mod tests {
     use super::*;
     use rdbvh_core::Vec3;
+
+    #[test]
+    fn the_octree_levels_help_says_the_default() {
+        // `--octree-levels` is an Option (so `--lookup list` can refuse it), and its help
+        // spells the default out.
+        assert_eq!(rdbvh_core::toplevel::DEFAULT_OCTREE_LEVELS, 5);
+    }
 
     #[test]
     fn csv_layout() {

@@ -6,6 +6,7 @@ use std::path::Path;
 use rayon::prelude::*;
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::influence::InfluenceArea;
+use rdbvh_core::toplevel::{Octree, Scene as Structure};
 
 use super::CliError;
 use crate::areas::{read_areas, AreaEntry};
@@ -19,17 +20,15 @@ pub fn load_areas(path: &Path, scene: &Scene) -> Result<Vec<AreaEntry>, CliError
     Ok(entries.into_iter().cloned().collect())
 }
 
-/// Ids of the triangles that overlap `area`, by the exact separating-axis test (a triangle that
-/// crosses the area with no vertex inside it is included), in id order.
+/// Ids of the triangles that `area` takes into its local BVH, in id order: the scene
+/// structure's own test ([`Structure::area_takes`]: a separating-axis test, so a triangle that crosses
+/// the area with no vertex inside it is included), on all threads, so `build`, `analyze`,
+/// `trace` and `experiment` report the same triangles for the same area.
 pub fn overlapping(triangles: &[Triangle], area: &InfluenceArea) -> Vec<u32> {
-    let bounds = area.bounds();
+    let bounds = area.bounds().padded();
     (0..triangles.len() as u32)
         .into_par_iter()
-        .filter(|&i| {
-            let t = &triangles[i as usize];
-            // The box test rejects most triangles cheaply; the SAT test is exact.
-            !t.bounds().intersection(bounds).is_empty() && area.overlaps_triangle(t)
-        })
+        .filter(|&i| Structure::<Octree>::area_takes(area, &bounds, &triangles[i as usize]))
         .collect()
 }
 
@@ -66,5 +65,37 @@ mod tests {
         assert!(!area.contains(crossing.v0) && !area.contains(crossing.v1));
         assert_eq!(overlapping(&[away, crossing, away], &area), vec![1]);
         assert_eq!(kind_name(&area), "plane");
+    }
+
+    #[test]
+    fn build_selects_what_the_scene_structure_selects() {
+        // Found by black-box testing: `build` prefiltered by the area's exact box and the scene
+        // structure by its padded box, so a 179-degree frustum (corners near 1e7, so a padding
+        // of about 20 units) gave `build` 439 triangles and `analyze`/`trace` 1005.
+        use rdbvh_core::influence::PointArea;
+        let eye = Vec3::splat(5.0);
+        let area: InfluenceArea = PointArea::new(eye, Vec3::Y, 179.0, 179.0, 1e-3, 1e5)
+            .unwrap()
+            .into();
+        let mut rng = rdbvh_core::random::Pcg32::new(3);
+        let tris: Vec<Triangle> = (0..400)
+            .map(|_| {
+                let a = Vec3::new(
+                    rng.range(0.0, 10.0),
+                    rng.range(-20.0, 10.0),
+                    rng.range(0.0, 10.0),
+                );
+                Triangle::new(a, a + Vec3::X, a + Vec3::Z)
+            })
+            .collect();
+        let structure: Vec<u32> = Structure::<Octree>::triangles_in_area(&area, &tris).collect();
+        assert_eq!(overlapping(&tris, &area), structure);
+        // The test is conservative: everything the area touches is taken (these triangles lie
+        // in planes y = const, so y >= 5 means inside the upward frustum's half-space).
+        assert!(tris
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| t.v0.y >= eye.y + 1.0)
+            .all(|(i, _)| structure.contains(&(i as u32))));
     }
 }

@@ -59,7 +59,7 @@ pub struct BuildReport {
     pub bytes: usize,
     /// Milliseconds to load the scene (parse the OBJ or generate the built-in scene).
     pub load_ms: f64,
-    /// With an area: milliseconds to pick the triangles that overlap it (exact SAT test).
+    /// With an area: milliseconds to pick the triangles that overlap it (the separating-axis test).
     pub select_ms: Option<f64>,
     /// Milliseconds of the build alone.
     pub build_ms: f64,

@@ -57,8 +57,9 @@ pub fn build() -> String {
     format!(
         "{PRESETS}\n\n\
          With --areas, the BVH holds only the triangles that overlap the first area that applies to\n\
-         the scene (exact separating-axis test), and the report adds pah_cost: the expected cost per\n\
-         ray of the area's rays under its PAH (C_trav = C_isect = 1, like sah_cost).\n\
+         the scene (separating-axis test, the scene structure's own), and the report adds pah_cost:\n\
+         the expected cost per ray of the area's rays under its PAH (C_trav = C_isect = 1, like\n\
+         sah_cost).\n\
          --json prints one object with the keys scene, triangles (in the build), scene_triangles,\n\
          nodes, leaves, max_depth, sah_cost, pah_cost, bytes, load_ms, select_ms, build_ms,\n\
          mtris_per_s, builder, preset, thesis_mode, area_kind, bins, max_leaf (null where they do not\n\

@@ -269,9 +269,32 @@ fn a_bom_is_not_part_of_the_first_vertex_and_an_experiment_checks_its_folder_fir
     )
     .unwrap();
     let e = experiment.to_str().unwrap();
+    // So do trace's outputs in a folder that does not exist, or that is a folder.
+    let nowhere = dir.join("absent").join("out.csv");
+    let (o, r, w) = (
+        obj.to_str().unwrap(),
+        rays.to_str().unwrap(),
+        nowhere.to_str().unwrap(),
+    );
+    fails(
+        &bin,
+        &["trace", o, "--rays", r, "--out", w],
+        "folder does not exist",
+    );
+    fails(
+        &bin,
+        &["trace", o, "--rays", r, "--out", dir.to_str().unwrap()],
+        "is a folder",
+    );
     fails(
         &bin,
         &["experiment", e, "--out", file.to_str().unwrap()],
         "not a folder",
+    );
+    // And analyze's --nodes (the area file here is the experiment's, [[config]] tables).
+    fails(
+        &bin,
+        &["analyze", o, "--areas", e, "--nodes", w],
+        "folder does not exist",
     );
 }

@@ -281,6 +281,9 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
             args.preset
         ))
     })?;
+    if let Some(nodes) = &args.nodes {
+        super::check_output(nodes)?;
+    }
     let (scene, _) = load_scene(&args.scene)?;
     let entries = load_areas(&args.areas, &scene)?;
     let setup = setup(args);

@@ -117,6 +117,26 @@ fn usage_error(e: &clap::Error) -> ExitCode {
     }
 }
 
+/// Fails early, before any work, when `path` cannot be an output file: it names a folder, or its
+/// folder does not exist. (Other failures, such as permissions, still show when it is written.)
+fn check_output(path: &std::path::Path) -> Result<(), CliError> {
+    let fail = |why: &str| CliError::Write {
+        path: path.to_path_buf(),
+        source: io::Error::new(io::ErrorKind::NotFound, why.to_string()),
+    };
+    if path.is_dir() {
+        return Err(fail("it is a folder"));
+    }
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => std::path::Path::new("."),
+    };
+    if !folder.is_dir() {
+        return Err(fail("its folder does not exist"));
+    }
+    Ok(())
+}
+
 /// `n` things in words: "1 thread", "2 threads".
 fn count(n: usize, thing: &str) -> String {
     format!("{n} {thing}{}", if n == 1 { "" } else { "s" })

@@ -242,20 +242,21 @@ fn finish<L: AreaLookup + Sync>(
     };
     let lines = [
         format!(
-            "traced {} ({kind}) against {} through {} with {}: {} hits, {:.3} ms, {:.0} rays/s",
+            "traced {} ({kind}) against {} through {} with {}: {}, {:.3} ms, {:.0} rays/s",
             super::count(n, "ray"),
             super::count(scene.len(), "triangle"),
             super::count(areas, "influence area"),
             super::count(rayon::current_num_threads(), "thread"),
-            t.answers.hits(),
+            super::count(t.answers.hits(), "hit"),
             t.seconds * 1e3,
             per_second(t.seconds)
         ),
         format!(
-            "local hit rate {:.2}% ({} of {n} rays answered by a local BVH; {} were affine to an \
-             area, {} used the fallback BVH)",
+            "local hit rate {:.2}% ({} of {} answered by a local BVH; {} affine to an area, {} \
+             used the fallback BVH)",
             100.0 * t.local_hit_rate(n),
             t.local,
+            super::count(n, "ray"),
             t.affine,
             n - t.local
         ),
@@ -268,14 +269,16 @@ fn finish<L: AreaLookup + Sync>(
             per_second(t.fallback_seconds)
         ),
         format!(
-            "structure: `{}` local BVHs{} over {local_triangles} area triangles, {lookup}, up \
-             to {} tr{} per ray, {} bytes, built in {:.3} ms",
+            "structure: `{}` {}{} over {}, {lookup}, up to {} tr{} per ray, {} bytes, built in \
+             {:.3} ms",
             options.preset,
+            super::count(areas, "local BVH"),
             if options.local.thesis_mode {
                 " (thesis mode)"
             } else {
                 ""
             },
+            super::count(local_triangles as usize, "area triangle"),
             options.max_tries,
             if options.max_tries == 1 { "y" } else { "ies" },
             structure.memory_bytes(),

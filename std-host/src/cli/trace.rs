@@ -135,6 +135,7 @@ pub fn trace<T: Traversable + Sync>(
 
 /// Runs `rdbvh trace`; the summary goes to `log` (standard error), so standard output stays free.
 pub fn run(args: &TraceArgs, log: &mut impl Write) -> Result<(), CliError> {
+    super::check_output(&args.out)?;
     if let Some(areas) = &args.areas {
         return structure::run(args, areas, log);
     }
@@ -162,11 +163,11 @@ pub fn run(args: &TraceArgs, log: &mut impl Write) -> Result<(), CliError> {
     };
     writeln!(
         log,
-        "traced {} ({kind}) against {} with {}: {} hits, {:.3} ms, {:.0} rays/s",
+        "traced {} ({kind}) against {} with {}: {}, {:.3} ms, {:.0} rays/s",
         super::count(rays.len(), "ray"),
         super::count(scene.len(), "triangle"),
         super::count(rayon::current_num_threads(), "thread"),
-        answers.hits(),
+        super::count(answers.hits(), "hit"),
         seconds * 1e3,
         per_second
     )

@@ -37,6 +37,13 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
+/// Runs `rdbvh args` and expects success.
+fn succeeds(bin: &Path, args: &[&str]) {
+    let out = Command::new(bin).args(args).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{args:?} failed: {stderr}");
+}
+
 /// Runs `rdbvh args`, expects failure with exactly one `error: ` line containing `needle`.
 fn fails(bin: &Path, args: &[&str], needle: &str) {
     let out = Command::new(bin).args(args).output().unwrap();
@@ -133,21 +140,16 @@ fn bad_rays_are_one_line_errors_and_empty_segments_miss() {
         "ox,oy,oz,dx,dy,dz,tmin,tmax\n5,5,5,0,-1,0,10,1\n5,5,5,0,-1,0,0,inf\n",
     )
     .unwrap();
-    let run = Command::new(&bin)
-        .args([
+    succeeds(
+        &bin,
+        &[
             "trace",
             "builtin:room",
             "--rays",
             path.to_str().unwrap(),
             "--out",
             out,
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
+        ],
     );
     let hits = std::fs::read_to_string(out).unwrap();
     let rows: Vec<&str> = hits.lines().collect();
@@ -219,16 +221,7 @@ fn bad_areas_are_one_line_errors() {
         &[&args[..], &["--lookup", "list", "--octree-levels", "4"]].concat(),
         "--octree-levels",
     );
-    let out = Command::new(&bin)
-        .args(args)
-        .args(["--octree-levels", "4"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    succeeds(&bin, &[&args[..], &["--octree-levels", "4"]].concat());
 }
 
 #[test]
@@ -245,15 +238,10 @@ fn a_bom_is_not_part_of_the_first_vertex_and_an_experiment_checks_its_folder_fir
     let rays = dir.join("rays.csv");
     std::fs::write(&rays, "ox,oy,oz,dx,dy,dz\n0.2,0.2,-1,0,0,1\n").unwrap();
     let hits = dir.join("hits.csv");
-    let out = Command::new(&bin)
-        .args(["trace", obj.to_str().unwrap(), "--rays"])
-        .args([rays.to_str().unwrap(), "--out", hits.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let (o, r) = (obj.to_str().unwrap(), rays.to_str().unwrap());
+    succeeds(
+        &bin,
+        &["trace", o, "--rays", r, "--out", hits.to_str().unwrap()],
     );
     let text = std::fs::read_to_string(&hits).unwrap();
     assert_eq!(text.lines().nth(1), Some("0,1,0,0.2,0.2"), "{text}");
@@ -271,11 +259,7 @@ fn a_bom_is_not_part_of_the_first_vertex_and_an_experiment_checks_its_folder_fir
     let e = experiment.to_str().unwrap();
     // So do trace's outputs in a folder that does not exist, or that is a folder.
     let nowhere = dir.join("absent").join("out.csv");
-    let (o, r, w) = (
-        obj.to_str().unwrap(),
-        rays.to_str().unwrap(),
-        nowhere.to_str().unwrap(),
-    );
+    let w = nowhere.to_str().unwrap();
     fails(
         &bin,
         &["trace", o, "--rays", r, "--out", w],

@@ -7,11 +7,11 @@
 //! Checking every face index against the vertices defined before it makes those inputs a clear
 //! [`SceneError::MissingVertex`] instead. The same pass skips polylines (`tobj` reads `l a b c` as a
 //! triangle) and rejects MTL colour lines with fewer than three values (`tobj` panics on them).
-//! It also checks every `v`, `vt` and `vn` line as `tobj` will parse it, so a malformed number is
-//! an error with its line too. Before either reads it, the text loses a UTF-8 byte-order mark
-//! (which `tobj` would take as part of the first statement: the first vertex was silently
-//! dropped) and any trailing `# comment` on a data line (`tobj` reads it as more numbers or
-//! indices).
+//! When `tobj` rejects a `v`, `vt` or `vn` line, a second pass finds it, so a malformed number
+//! is an error with its line too (only on that error path: parsing every number twice made loading
+//! a third slower). Before either reads it, the text loses a UTF-8 byte-order mark (which `tobj`
+//! would take as part of the first statement: the first vertex was silently dropped) and any
+//! trailing `# comment` on a data line (`tobj` reads it as more numbers or indices).
 
 use std::borrow::Cow;
 
@@ -117,8 +117,8 @@ impl Scene {
     ) -> Result<Scene, SceneError> {
         let text = normalized(text);
         let check = check_obj(&text, label)?;
-        let text = if check.has_polylines || check.mixed_colours {
-            Cow::Owned(sanitized(&text, &check))
+        let text = if check.has_polylines {
+            Cow::Owned(sanitized(&text, false))
         } else {
             text
         };
@@ -130,13 +130,40 @@ impl Scene {
             ignore_lines: true,
             ..Default::default()
         };
-        let (models, loaded) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |name| {
-            load_mtl(name, materials, &warnings)
-        })
-        .map_err(|e| SceneError::Malformed {
-            path: label.to_path_buf(),
-            line: None,
-            reason: e.to_string(),
+        let load = |text: &str| {
+            tobj::load_obj_buf(&mut text.as_bytes(), &options, |name| {
+                load_mtl(name, materials, &warnings)
+            })
+        };
+        let loaded = match load(&text) {
+            // Colours on some positions and not on others: `tobj` fails on the faces. They are
+            // unused here, so they go and the text loads again.
+            Err(tobj::LoadError::FaceColorOutOfBounds) => {
+                warnings.borrow_mut().clear();
+                load(&sanitized(&text, true))
+            }
+            other => other,
+        };
+        let (models, loaded) = loaded.map_err(|e| {
+            use tobj::LoadError as E;
+            // Name the line `tobj` rejected, when it was a vertex line.
+            let vertex = matches!(
+                e,
+                E::PositionParseError
+                    | E::ScalingByZeroError
+                    | E::ColorParseError
+                    | E::TexcoordParseError
+                    | E::NormalParseError
+            );
+            let (line, reason) = match vertex.then(|| vertex_line_error(&text)).flatten() {
+                Some((line, reason)) => (Some(line), reason),
+                None => (None, e.to_string()),
+            };
+            SceneError::Malformed {
+                path: label.to_path_buf(),
+                line,
+                reason,
+            }
         })?;
         let mut warnings = warnings.into_inner();
         // A failed library was already reported; `tobj` only returns its error when no library
@@ -241,9 +268,6 @@ fn check_finite(triangles: &[Triangle], label: &Path) -> Result<(), SceneError> 
 struct ObjCheck {
     /// `l` lines present (to be hidden from `tobj`).
     has_polylines: bool,
-    /// Some positions carry an RGB colour and some do not: `tobj` then fails on the faces
-    /// ("face vertex color index out of bounds"), so the colours (unused here) are dropped.
-    mixed_colours: bool,
     /// Points, polylines and faces with fewer than 3 vertices.
     skipped: usize,
     /// Material names given to `usemtl`, first use first.
@@ -255,7 +279,8 @@ const DATA_STATEMENTS: [&str; 7] = ["v", "vt", "vn", "vp", "f", "l", "p"];
 
 /// The text as the checks and `tobj` read it: without a leading UTF-8 byte-order mark, and with
 /// a trailing `# comment` cut from every data line ([`DATA_STATEMENTS`]); other lines (names of
-/// materials, groups, libraries) are kept whole. Borrowed when nothing changes.
+/// materials, groups, libraries) are kept whole. Borrowed when nothing changes, which only the
+/// lines holding a `#` can tell.
 fn normalized(text: &str) -> Cow<'_, str> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let is_data = |line: &str| {
@@ -263,7 +288,12 @@ fn normalized(text: &str) -> Cow<'_, str> {
             .next()
             .is_some_and(|w| DATA_STATEMENTS.contains(&w))
     };
-    if !text.lines().any(|line| line.contains('#') && is_data(line)) {
+    let line_at = |at: usize| {
+        let start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+        let end = text[at..].find('\n').map_or(text.len(), |i| at + i);
+        &text[start..end]
+    };
+    if !text.match_indices('#').any(|(at, _)| is_data(line_at(at))) {
         return Cow::Borrowed(text);
     }
     let mut out = String::with_capacity(text.len());
@@ -313,9 +343,23 @@ fn check_numbers<'a>(
     }
 }
 
+/// The first `v`, `vt` or `vn` line whose numbers `tobj` would reject ([`check_numbers`]), with
+/// its line number and why: run only after `tobj` failed, to name the line.
+fn vertex_line_error(text: &str) -> Option<(usize, String)> {
+    text.lines().enumerate().find_map(|(i, line)| {
+        let mut words = line.split_whitespace();
+        let (count, what) = match words.next() {
+            Some("v") => (3, "position"),
+            Some("vt") => (2, "texture coordinate"),
+            Some("vn") => (3, "normal"),
+            _ => return None,
+        };
+        check_numbers(words, count, what).err().map(|e| (i + 1, e))
+    })
+}
+
 /// Checks every face index against the positions, texture coordinates and normals defined before
-/// the face (the OBJ rule, and what `tobj` resolves relative indices against), every `usemtl`,
-/// and the numbers of every `v`, `vt` and `vn` line.
+/// the face (the OBJ rule, and what `tobj` resolves relative indices against), and every `usemtl`.
 fn check_obj(text: &str, label: &Path) -> Result<ObjCheck, SceneError> {
     let malformed = |line: usize, reason: String| SceneError::Malformed {
         path: label.to_path_buf(),
@@ -326,8 +370,6 @@ fn check_obj(text: &str, label: &Path) -> Result<ObjCheck, SceneError> {
     let mut seen_materials = HashSet::new();
     // Positions, texture coordinates, normals defined so far.
     let mut defined = [0usize; 3];
-    // Whether some position has no colour, and whether some has one.
-    let mut colours = [false; 2];
     const KINDS: [VertexKind; 3] = [
         VertexKind::Position,
         VertexKind::TexCoord,
@@ -336,23 +378,10 @@ fn check_obj(text: &str, label: &Path) -> Result<ObjCheck, SceneError> {
     for (i, line) in text.lines().enumerate() {
         let number = i + 1;
         let mut words = line.split_whitespace();
-        let statement = words.next();
-        let numbers = match statement {
-            Some("v") => Some((0, 3, "position")),
-            Some("vt") => Some((1, 2, "texture coordinate")),
-            Some("vn") => Some((2, 3, "normal")),
-            _ => None,
-        };
-        if let Some((kind, count, what)) = numbers {
-            if kind == 0 {
-                // `check_numbers` accepts 3, 4 or 6 numbers; 6 is a colour.
-                let coloured = line.split_whitespace().count() == 7;
-                colours[usize::from(coloured)] = true;
-            }
-            check_numbers(words.by_ref(), count, what).map_err(|e| malformed(number, e))?;
-            defined[kind] += 1;
-        }
-        match statement {
+        match words.next() {
+            Some("v") => defined[0] += 1,
+            Some("vt") => defined[1] += 1,
+            Some("vn") => defined[2] += 1,
             Some("l") => {
                 check.has_polylines = true;
                 check.skipped += 1;
@@ -413,25 +442,24 @@ fn check_obj(text: &str, label: &Path) -> Result<ObjCheck, SceneError> {
             _ => {}
         }
     }
-    check.mixed_colours = colours == [true; 2];
     Ok(check)
 }
 
 /// The text as `tobj` should read it after the check: every `l` line blanked (kept as an empty
-/// line so line numbers stay the same) and, when only some positions carry a colour, every `v`
-/// line cut to its coordinates and weight.
-fn sanitized(text: &str, check: &ObjCheck) -> String {
+/// line so line numbers stay the same) and, with `no_colours`, every `v` line cut to its
+/// coordinates and weight (for files where only some positions carry a colour).
+fn sanitized(text: &str, no_colours: bool) -> String {
     let mut out = String::with_capacity(text.len());
     for line in text.lines() {
         let mut words = line.split_whitespace();
         match words.next() {
             Some("l") => {}
-            Some("v") if check.mixed_colours => {
+            Some("v") if no_colours => {
                 let numbers: Vec<&str> = words.collect();
                 out.push('v');
                 // 3 coordinates, or 3 and a weight; a colour's three numbers go.
                 let keep = if numbers.len() == 4 { 4 } else { 3 };
-                for n in &numbers[..keep] {
+                for n in numbers.iter().take(keep) {
                     out.push(' ');
                     out.push_str(n);
                 }
@@ -591,11 +619,10 @@ mod tests {
             ("v 0 x 0\n", "'x' is not a number"),
             ("v 0 0 0 0\n", "weight w is 0"),
             ("v 0 0 0 1 1\n", "has 5 numbers"),
-            ("v 0 0 0 1 1 z\n", "colour component 'z'"),
             ("vt 0\n", "texture coordinate needs 2 numbers, found 1"),
             ("vn 0 0 abc\n", "normal: coordinate 'abc'"),
         ] {
-            let text = format!("v 0 0 0\nv 1 0 0\n{text}v 0 1 0\nf 1 2 4\n");
+            let text = format!("v 0 0 0\nv 1 0 0\n{text}v 0 1 0\nf 1 2 3\n");
             match err(&text) {
                 SceneError::Malformed {
                     line: Some(3),
@@ -606,10 +633,13 @@ mod tests {
             }
         }
         assert!(err("v 0 0\n").to_string().contains(MEMORY_LABEL));
-        // What `tobj` reads and the check accepts: a weight, a colour (on some vertices only:
-        // `tobj` fails on that, so the colours are dropped), a third texture coordinate.
-        let s = Scene::from_obj_str("v 0 0 0 2\nv 1 0 0 0.5 0.5 0.5\nvt 0 0 0\nv 0 1 0\nf 1 2 3\n")
-            .unwrap();
+        // What loads: a weight, a colour (on some vertices only: `tobj` fails on that, so the
+        // colours go and the text loads again), a third texture coordinate, and a colour that is
+        // not a number (`tobj` ignores it; colours are unused here).
+        let s = Scene::from_obj_str(
+            "v 0 0 0 2\nv 1 0 0 0.5 0.5 0.5\nvt 0 0 0\nv 0 1 0 1 1 z\nf 1 2 3\n",
+        )
+        .unwrap();
         assert_eq!(s.triangles[0].v1, Vec3::X);
     }
 

@@ -101,7 +101,7 @@ pub enum Clock {
 /// How long to measure.
 #[derive(Clone, Copy, Debug)]
 pub struct Options {
-    /// Fewest rounds: repetitions of every measurement, interleaved (see [`interleave`]).
+    /// Fewest rounds: repetitions of every measurement, interleaved (see `interleave`).
     pub min_reps: usize,
     /// Most rounds.
     pub max_reps: usize,

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The project's one test command (the README's `bash scripts/test.sh`; CI runs it through .ci/run
-# with CI=true). On a fresh machine it installs what it needs, then checks formatting, lints, runs
-# every test in release, and proves the core builds for a bare-metal target.
+# with CI=true). On a fresh machine it installs what it needs, then checks formatting, lints and
+# doc links, runs every test in release, and proves the core builds for a bare-metal target.
 #
 # With CI=true, the real-scene tests fail instead of skipping when ../shared is missing.
 #
@@ -37,6 +37,9 @@ cargo fmt --manifest-path "$CONSUMER/Cargo.toml" -- --check
 section "lints (cargo clippy -D warnings)"
 cargo clippy --workspace --all-targets -- -D warnings
 cargo clippy --manifest-path "$CONSUMER/Cargo.toml" --target "$TARGET" -- -D warnings
+
+section "docs (cargo doc -D warnings: broken and private links)"
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps
 
 section "tests (cargo test --workspace --release)"
 cargo test --workspace --release 2>&1 | tee "$LOG_DIR/test.log"

@@ -270,6 +270,11 @@ fn a_bom_is_not_part_of_the_first_vertex_and_an_experiment_checks_its_folder_fir
         &["trace", o, "--rays", r, "--out", dir.to_str().unwrap()],
         "is a folder",
     );
+    // Or that is one of its inputs (it used to replace the rays with the hits).
+    fails(&bin, &["trace", o, "--rays", r, "--out", r], "input files");
+    assert!(std::fs::read_to_string(&rays)
+        .unwrap()
+        .starts_with("ox,oy,oz"));
     fails(
         &bin,
         &["experiment", e, "--out", file.to_str().unwrap()],

@@ -282,7 +282,7 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
         ))
     })?;
     if let Some(nodes) = &args.nodes {
-        super::check_output(nodes)?;
+        super::check_output(nodes, &[Path::new(&args.scene), args.areas.as_path()])?;
     }
     let (scene, _) = load_scene(&args.scene)?;
     let entries = load_areas(&args.areas, &scene)?;

@@ -117,9 +117,10 @@ fn usage_error(e: &clap::Error) -> ExitCode {
     }
 }
 
-/// Fails early, before any work, when `path` cannot be an output file: it names a folder, or its
-/// folder does not exist. (Other failures, such as permissions, still show when it is written.)
-fn check_output(path: &std::path::Path) -> Result<(), CliError> {
+/// Fails early, before any work, when `path` cannot be an output file: it names a folder, its
+/// folder does not exist, or it is one of the command's `inputs` (writing it would destroy the
+/// input). Other failures, such as permissions, still show when it is written.
+fn check_output(path: &std::path::Path, inputs: &[&std::path::Path]) -> Result<(), CliError> {
     let fail = |why: &str| CliError::Write {
         path: path.to_path_buf(),
         source: io::Error::new(io::ErrorKind::NotFound, why.to_string()),
@@ -133,6 +134,14 @@ fn check_output(path: &std::path::Path) -> Result<(), CliError> {
     };
     if !folder.is_dir() {
         return Err(fail("its folder does not exist"));
+    }
+    if let Ok(out) = path.canonicalize() {
+        if inputs
+            .iter()
+            .any(|i| i.canonicalize().is_ok_and(|i| i == out))
+        {
+            return Err(fail("it is one of the command's input files"));
+        }
     }
     Ok(())
 }

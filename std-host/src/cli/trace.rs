@@ -135,7 +135,12 @@ pub fn trace<T: Traversable + Sync>(
 
 /// Runs `rdbvh trace`; the summary goes to `log` (standard error), so standard output stays free.
 pub fn run(args: &TraceArgs, log: &mut impl Write) -> Result<(), CliError> {
-    super::check_output(&args.out)?;
+    let inputs = [Path::new(&args.scene), args.rays.as_path()];
+    let areas = args.areas.as_deref().into_iter();
+    super::check_output(
+        &args.out,
+        &inputs.into_iter().chain(areas).collect::<Vec<_>>(),
+    )?;
     if let Some(areas) = &args.areas {
         return structure::run(args, areas, log);
     }

@@ -308,8 +308,7 @@ fn normalized(text: &str) -> Cow<'_, str> {
 }
 
 /// Checks a `v`, `vt` or `vn` line's numbers (`words`, after the statement) as `tobj` parses
-/// them: `count` numbers first (x y z; u v; x y z); a position may add a weight `w` (not zero:
-/// `tobj` divides by it) or an RGB colour.
+/// them: `count` numbers first (x y z; u v; x y z), then for a position [`check_position_extras`].
 fn check_numbers<'a>(
     mut words: impl Iterator<Item = &'a str>,
     count: usize,
@@ -328,16 +327,34 @@ fn check_numbers<'a>(
     if what != "position" {
         return Ok(());
     }
-    let rest: Vec<&str> = words.collect();
-    match rest.as_slice() {
+    check_position_extras(&words.collect::<Vec<_>>())
+}
+
+/// Checks what follows a position's three coordinates: nothing, a weight `w` (`tobj` divides the
+/// coordinates by it, so it must be finite and not zero: an infinite one silently moved the vertex
+/// to the origin), or an RGB colour of three numbers (unused here, but `tobj` would skip a bad
+/// one without a word).
+fn check_position_extras(rest: &[&str]) -> Result<(), String> {
+    let number = |w: &str, name: &str| {
+        w.parse::<f32>()
+            .map_err(|_| format!("position: {name} '{w}' is not a number"))
+    };
+    match rest {
         [] => Ok(()),
-        [w] if number(w, "weight")? == 0.0 => Err(format!("{what}: weight w is 0")),
-        [_] => Ok(()),
+        [w] => {
+            let w = number(w, "weight")?;
+            if w == 0.0 || !w.is_finite() {
+                return Err(format!(
+                    "position: weight w is {w} (it must be finite and not 0)"
+                ));
+            }
+            Ok(())
+        }
         [r, g, b] => [r, g, b]
             .into_iter()
             .try_for_each(|c| number(c, "colour component").map(|_| ())),
         more => Err(format!(
-            "{what} has {} numbers: expected 3, 4 (with a weight) or 6 (with a colour)",
+            "position has {} numbers: expected 3, 4 (with a weight) or 6 (with a colour)",
             3 + more.len()
         )),
     }
@@ -379,7 +396,21 @@ fn check_obj(text: &str, label: &Path) -> Result<ObjCheck, SceneError> {
         let number = i + 1;
         let mut words = line.split_whitespace();
         match words.next() {
-            Some("v") => defined[0] += 1,
+            Some("v") => {
+                // The coordinates are `tobj`'s to check (a bad one names its line through
+                // `vertex_line_error`); a weight or colour after them, rare, is checked here,
+                // since `tobj` accepts some bad ones.
+                // Most lines are `v x y z`: at most three separators, so no extras (counting
+                // bytes costs a fraction of splitting words; `split_whitespace` decides the rest).
+                let separators = line.bytes().filter(|&b| b == b' ' || b == b'\t').count();
+                if separators > 3 {
+                    let rest: Vec<&str> = words.by_ref().skip(3).collect();
+                    if !rest.is_empty() {
+                        check_position_extras(&rest).map_err(|e| malformed(number, e))?;
+                    }
+                }
+                defined[0] += 1;
+            }
             Some("vt") => defined[1] += 1,
             Some("vn") => defined[2] += 1,
             Some("l") => {
@@ -618,6 +649,8 @@ mod tests {
             ("v 0 0\n", "position needs 3 numbers, found 2"),
             ("v 0 x 0\n", "'x' is not a number"),
             ("v 0 0 0 0\n", "weight w is 0"),
+            ("v 0 0 1 inf\n", "weight w is inf"),
+            ("v 0 0 1 a b c\n", "colour component 'a'"),
             ("v 0 0 0 1 1\n", "has 5 numbers"),
             ("vt 0\n", "texture coordinate needs 2 numbers, found 1"),
             ("vn 0 0 abc\n", "normal: coordinate 'abc'"),
@@ -634,12 +667,9 @@ mod tests {
         }
         assert!(err("v 0 0\n").to_string().contains(MEMORY_LABEL));
         // What loads: a weight, a colour (on some vertices only: `tobj` fails on that, so the
-        // colours go and the text loads again), a third texture coordinate, and a colour that is
-        // not a number (`tobj` ignores it; colours are unused here).
-        let s = Scene::from_obj_str(
-            "v 0 0 0 2\nv 1 0 0 0.5 0.5 0.5\nvt 0 0 0\nv 0 1 0 1 1 z\nf 1 2 3\n",
-        )
-        .unwrap();
+        // colours go and the text loads again), a third texture coordinate.
+        let s = Scene::from_obj_str("v 0 0 0 2\nv 1 0 0 0.5 0.5 0.5\nvt 0 0 0\nv 0 1 0\nf 1 2 3\n")
+            .unwrap();
         assert_eq!(s.triangles[0].v1, Vec3::X);
     }
 

@@ -7,7 +7,7 @@ use rdbvh_core::heuristics::CostConstants;
 use serde::Deserialize;
 
 use super::ExperimentError;
-use crate::areas::{parse_areas, AreaEntry, AreasErrorKind};
+use crate::areas::{parse_areas, AreaEntry, AreasErrorKind, TableKind};
 
 /// `[settings]`: every key is optional. `rays_per_config` and `heuristics` apply in every mode;
 /// the builder keys apply only with `--thesis-mode` (without it the project's binned builder runs
@@ -181,6 +181,13 @@ impl ExperimentFile {
             )),
             _ => ExperimentError::Areas(e.to_string()),
         })?;
+        if areas.tables == TableKind::Area {
+            return Err(ExperimentError::Areas(format!(
+                "{}: an experiment runs [[config]] tables, each naming its scene with `file = ...`; \
+                 [[area]] tables (for build, trace and analyze) name none, so nothing would run",
+                path.display()
+            )));
+        }
         let base = path.parent().unwrap_or(Path::new("."));
         let scene_dir = match top.scene_dir {
             Some(d) => base.join(d),
@@ -212,6 +219,9 @@ mod tests {
         assert!(e.to_string().starts_with("e.toml line 2: "), "{e}");
         let e = ExperimentFile::parse("[settings]\n", Path::new("e.toml")).unwrap_err();
         assert!(e.to_string().contains("no configurations"), "{e}");
+        let areas = text.replace("[[config]]", "[[area]]");
+        let e = ExperimentFile::parse(&areas, Path::new("e.toml")).unwrap_err();
+        assert!(e.to_string().contains("[[config]] tables"), "{e}");
         assert!(parse_presets(["full", "bogus"]).is_err());
         assert_eq!(
             parse_presets(["Full", "full", "standard"]).unwrap(),

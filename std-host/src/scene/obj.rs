@@ -74,10 +74,11 @@ impl Scene {
     /// published OBJ files (several of the thesis scenes) name an `.mtl` that was never shipped.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
             path: path.to_path_buf(),
             source,
         })?;
+        let text = utf8_text(bytes, path)?;
         let dir = path.parent().unwrap_or(Path::new(""));
         let mut scene = Scene::from_obj_str_with(&text, path, MaterialFiles::Folder(dir))?;
         scene.name = path.file_name().map_or_else(
@@ -94,14 +95,14 @@ impl Scene {
         label: &Path,
         materials: MaterialFiles<'_>,
     ) -> Result<Scene, SceneError> {
-        let mut text = String::new();
+        let mut bytes = Vec::new();
         reader
-            .read_to_string(&mut text)
+            .read_to_end(&mut bytes)
             .map_err(|source| SceneError::Io {
                 path: label.to_path_buf(),
                 source,
             })?;
-        Scene::from_obj_str_with(&text, label, materials)
+        Scene::from_obj_str_with(&utf8_text(bytes, label)?, label, materials)
     }
 
     /// Loads OBJ text with no material libraries (each `mtllib` gives a warning).
@@ -245,6 +246,22 @@ impl Scene {
     }
 }
 
+/// The file's bytes as text, or an [`SceneError::Io`] (invalid data) naming the line and byte of
+/// the first one that is not UTF-8 (the standard library's message names neither).
+fn utf8_text(bytes: Vec<u8>, label: &Path) -> Result<String, SceneError> {
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let line = e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+        SceneError::Io {
+            path: label.to_path_buf(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("not UTF-8 text: line {line} (byte {at}) holds a byte that is not UTF-8"),
+            ),
+        }
+    })
+}
+
 /// Rejects the first triangle with a NaN or infinite coordinate. Only vertices used by faces are
 /// checked: an unused bad vertex cannot reach a BVH.
 fn check_finite(triangles: &[Triangle], label: &Path) -> Result<(), SceneError> {
@@ -277,12 +294,17 @@ struct ObjCheck {
 /// Statements whose words are all numbers or indices, so a `#` in them can only start a comment.
 const DATA_STATEMENTS: [&str; 7] = ["v", "vt", "vn", "vp", "f", "l", "p"];
 
-/// The text as the checks and `tobj` read it: without a leading UTF-8 byte-order mark, and with
+/// The text as the checks and `tobj` read it: without a leading UTF-8 byte-order mark, with CR
+/// line ends made LF when the file has no LF at all, and with
 /// a trailing `# comment` cut from every data line ([`DATA_STATEMENTS`]); other lines (names of
 /// materials, groups, libraries) are kept whole. Borrowed when nothing changes, which only the
 /// lines holding a `#` can tell.
 fn normalized(text: &str) -> Cow<'_, str> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    // Classic Mac OS line ends (CR alone) read as one long line otherwise.
+    if text.contains('\r') && !text.contains('\n') {
+        return Cow::Owned(normalized(&text.replace('\r', "\n")).into_owned());
+    }
     let is_data = |line: &str| {
         line.split_whitespace()
             .next()
@@ -679,6 +701,8 @@ mod tests {
         // so every face index silently shifted by one.
         let s = Scene::from_obj_str(&format!("\u{feff}{QUAD}")).unwrap();
         assert_eq!(s.triangles, Scene::from_obj_str(QUAD).unwrap().triangles);
+        let s = Scene::from_obj_str(&QUAD.replace('\n', "\r")).unwrap();
+        assert_eq!(s.triangles, Scene::from_obj_str(QUAD).unwrap().triangles);
         let commented = "v 0 0 0 # origin\nv 1 0 0\nv 0 1 0#tight\nusemtl a#b\nf 1 2 3 # one\n";
         let s = Scene::from_obj_str(commented).unwrap();
         assert_eq!(s.triangles[0].v2, Vec3::Y);
@@ -818,6 +842,7 @@ mod tests {
         )
         .unwrap_err();
         assert!(matches!(e, SceneError::Io { .. }), "{e}");
+        assert!(e.to_string().contains("line 1 (byte 7)"), "{e}");
     }
 
     #[test]

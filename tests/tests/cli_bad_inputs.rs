@@ -286,4 +286,18 @@ fn a_bom_is_not_part_of_the_first_vertex_and_an_experiment_checks_its_folder_fir
         &["analyze", o, "--areas", e, "--nodes", w],
         "folder does not exist",
     );
+    let json = dir.join("nodes.json");
+    let args = [
+        "analyze",
+        o,
+        "--areas",
+        e,
+        "--nodes",
+        json.to_str().unwrap(),
+    ];
+    fails(
+        &bin,
+        &[&args[..], &["--columns", "index"]].concat(),
+        "--columns",
+    );
 }

@@ -214,6 +214,12 @@ fn node_field(r: &NodeRecord, col: &str) -> String {
     }
 }
 
+/// True for a `.json` node export (JSON, the whole tree), false for CSV.
+fn is_json(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+}
+
 fn write_nodes(
     path: &Path,
     records: &[NodeRecord],
@@ -223,10 +229,7 @@ fn write_nodes(
         path: path.to_path_buf(),
         source: e,
     };
-    if path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
-    {
+    if is_json(path) {
         let nodes: Vec<Value> = records
             .iter()
             .map(|r| {
@@ -283,6 +286,12 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
     })?;
     if let Some(nodes) = &args.nodes {
         super::check_output(nodes, &[Path::new(&args.scene), args.areas.as_path()])?;
+        if args.columns.is_some() && is_json(nodes) {
+            return Err(CliError::Usage(
+                "--columns chooses the CSV export's columns; a .json export writes every field"
+                    .into(),
+            ));
+        }
     }
     let (scene, _) = load_scene(&args.scene)?;
     let entries = load_areas(&args.areas, &scene)?;

@@ -260,8 +260,8 @@ mod tests {
     #[test]
     fn threaded_perspective_pah_build_equals_single_threaded() {
         // The jobs' roots take the measures the top's splits priced them with, as the
-        // single-threaded build does (the perspective measure's 4-wide and scalar paths need not
-        // agree to the bit; `graft`'s tests check that a job's measure is used).
+        // single-threaded build does (`graft`'s tests check that a job's measure is used), and a
+        // box's measure does not depend on the boxes beside it in a group of four.
         let tris = soup(40_000);
         for (eye, fov) in [
             (Vec3::new(0.0, 14.0, 0.0), 80.0),

@@ -826,10 +826,9 @@ fn sweep_any<M: CostModel>(bins: &[Bin], sweep: &mut Sweep, model: &M, hint: u32
     }
     // Lanes past the last boundary, up to the end of its group of four: empty on both sides, so
     // they price as +inf (no primitive on the right) and never hold a box left by an earlier,
-    // wider sweep. A model may choose how to measure a group from all four of its lanes
-    // (perspective PAH's far-field test does), so a stale box there could change what the
-    // real lanes cost: a reused arena and a fresh one (a threaded build's job) would then
-    // price the same node differently.
+    // wider sweep. Models measure each lane alone (`CostModel::measure4`), but a stale box is
+    // still measured: perspective PAH once chose its rule per group, and a stale box made a
+    // reused arena and a fresh one (a threaded job's) price the same node a few ulps apart.
     for i in nb..=(nb - 1).div_ceil(4) * 4 {
         sweep.left.set(i, &Bin::EMPTY);
         sweep.right.set(i, &Bin::EMPTY);
@@ -1340,17 +1339,19 @@ mod tests {
 
     #[test]
     fn a_sweep_prices_the_same_whatever_an_earlier_sweep_left() {
-        // Perspective PAH chooses its rule (far-field or exact) per group of four boxes, so a
-        // lane past the last boundary must hold the same thing in every sweep: left over from a
-        // wider sweep, it once made a fresh arena (a threaded job's) and a reused one (the
-        // single-threaded build's) price the same boundaries a few ulps apart.
+        // A sweep prices a node the same whatever an earlier, wider sweep left in the lanes past
+        // its last boundary. It once did not: perspective PAH chose its rule (far-field or
+        // exact) per group of four, and a stale near box there made a fresh arena (a threaded
+        // job's) and a reused one (the single-threaded build's) price the same boundaries a few
+        // ulps apart. The padding is now emptied and the rule chosen per lane; either alone
+        // keeps this test passing.
         use crate::heuristics::{PahPerspective, PerspectiveMeasure};
         use crate::influence::PointArea;
         let area = PointArea::new(Vec3::ZERO, Vec3::Z, 60.0, 60.0, 0.1, 1e4).unwrap();
         let pah = PahPerspective::for_area(&area, PerspectiveMeasure::SolidAngle);
         // Four bins in a row 1e3 ahead: each candidate box is far (half-diagonal under 1% of its
         // distance: the far-field rule), but the node as a whole is not quite, so no hint
-        // settles it and the sweep decides per group. And a box near the eye (exact) to leave
+        // settles it and each lane decides. And a box near the eye (exact) to leave
         // behind.
         let bins: [Bin; 4] = core::array::from_fn(|i| {
             let lo = Vec3::new(i as f32 * 4.975 - 9.95, -0.01, 1e3);

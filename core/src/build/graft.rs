@@ -32,8 +32,8 @@ impl core::error::Error for GraftError {}
 impl Bvh {
     /// Replaces each job's placeholder leaf in `top` (from [`super::Builder::build_top`]) with the
     /// subtree built for it (with [`super::Builder::build_subtree_into`] for the job, over its
-    /// slots in slot order), then lays the nodes out in the order the single-threaded builder allocates
-    /// them, so the result equals `build_into`'s tree node for node.
+    /// slots in slot order), then lays the nodes out in the order the single-threaded builder
+    /// allocates them, so the result equals `build_into`'s tree node for node.
     pub fn graft(top: Bvh, jobs: &[Subtree], subtrees: &[Bvh]) -> Result<Bvh, GraftError> {
         if jobs.len() != subtrees.len() {
             return Err(GraftError::CountMismatch);

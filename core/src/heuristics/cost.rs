@@ -43,7 +43,10 @@ pub trait CostModel {
 
     /// The measures of four boxes at once: the builder's sweeps price candidate splits four at a
     /// time through this. The default measures each lane with [`CostModel::measure`]; models with
-    /// a closed form override it with one 4-wide evaluation.
+    /// a closed form override it with one 4-wide evaluation. Each lane must be what `measure`
+    /// gives that box alone, whatever the other lanes hold: the same node meets different
+    /// neighbours in a threaded build's job and in the single-threaded build, and both must
+    /// make the same tree.
     #[inline]
     fn measure4(&self, b: &Aabb4) -> f32x4 {
         f32x4::from([

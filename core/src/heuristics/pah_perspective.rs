@@ -166,7 +166,7 @@ impl PahPerspective {
     /// the boxes wholly beyond the near plane and (when culling) inside the fields of view, which
     /// are most boxes of a build below its top levels. Seen from a point outside a box, the faces
     /// turned towards it tile the silhouette, one face per axis at most, so the measure is a sum
-    /// over those faces: [`Self::exact4`], or [`Self::far4`] when every lane is far.
+    /// over those faces, each lane by the rule its distance allows ([`Self::by_distance4`]).
     #[inline(always)]
     fn front_faces4(&self, b: &Aabb4) -> (f32x4, f32x4) {
         let (rel_lo, rel_hi) = self.relative(b);
@@ -176,11 +176,32 @@ impl PahPerspective {
         if inside_bits == 0 {
             return (f32x4::ZERO, inside);
         }
-        // Far from the eye the midpoint rule per face is as good as exact (see `far_field4`).
-        if (self.far_lanes(&c, &h).to_bitmask() | !inside_bits) & 0b1111 == 0b1111 {
-            return (self.far4(&rel_lo, &rel_hi), inside);
+        let far = self.far_lanes(&c, &h);
+        (self.by_distance4(&rel_lo, &rel_hi, far, !inside), inside)
+    }
+
+    /// The measures of four boxes in front of the eye, each by the rule its own distance allows:
+    /// the midpoint rule for the `far` lanes (as good as exact there, see `far_field4`), the
+    /// exact formula for the others; lanes in `skip` are not needed. The rule is chosen per lane,
+    /// so a box's measure never depends on the boxes that share its group (a sweep's padding, a
+    /// threaded build's different neighbours): a group that mixes the two evaluates both.
+    #[inline(always)]
+    fn by_distance4(
+        &self,
+        rel_lo: &[f32x4; 3],
+        rel_hi: &[f32x4; 3],
+        far: f32x4,
+        skip: f32x4,
+    ) -> f32x4 {
+        if (far | skip).all() {
+            return self.far4(rel_lo, rel_hi);
         }
-        (self.exact4(&rel_lo, &rel_hi), inside)
+        let exact = self.exact4(rel_lo, rel_hi);
+        if (far & !skip).any() {
+            far.select(self.far4(rel_lo, rel_hi), exact)
+        } else {
+            exact
+        }
     }
 
     /// The lanes far enough from the eye for the midpoint rule (`far_field4`):
@@ -345,11 +366,7 @@ impl CostModel for PahPerspective {
             self.far4(&rel_lo, &rel_hi)
         } else {
             let (c, h) = centre_half(&rel_lo, &rel_hi);
-            if (self.far_lanes(&c, &h) | empty).all() {
-                self.far4(&rel_lo, &rel_hi)
-            } else {
-                self.exact4(&rel_lo, &rel_hi)
-            }
+            self.by_distance4(&rel_lo, &rel_hi, self.far_lanes(&c, &h), empty)
         };
         empty.select(f32x4::ZERO, m)
     }
@@ -480,11 +497,16 @@ mod tests {
         ] {
             let pah = PahPerspective::for_area(&area, m);
             for _ in 0..500 {
-                // Boxes inside the window, straddling it or the near plane, behind the eye, and
-                // empty, mixed in one group of four.
+                // Boxes inside the window, straddling it or the near plane, behind the eye,
+                // small and far (the midpoint rule's), and empty, mixed in one group of four:
+                // each lane's rule is its own, so the groups agree with one box at a time.
                 let lanes: [Aabb; 4] = core::array::from_fn(|_| {
                     if rng.range(0.0, 1.0) < 0.1 {
                         return Aabb::EMPTY;
+                    }
+                    if rng.range(0.0, 1.0) < 0.3 {
+                        let lo = Vec3::new(rng.range(-2.0, 2.0), rng.range(-2.0, 2.0), 30.0);
+                        return Aabb::new(lo, lo + Vec3::splat(rng.range(0.01, 0.3)));
                     }
                     let lo = Vec3::new(
                         rng.range(-8.0, 8.0),

@@ -117,8 +117,8 @@ impl SceneStats {
 /// traverses each one's local BVH over the part of the segment inside the area, `[t_min, t_exit]`.
 /// A local hit is accepted only there (a closer triangle just outside the area cannot exist: the
 /// segment up to `t_exit` lies inside the area, and every triangle meeting the area is in its
-/// local BVH by the conservative separating-axis test of [`Scene::area_takes`]). Otherwise the fallback BVH answers the rest of the
-/// segment. Every answer equals the brute-force one.
+/// local BVH by the conservative separating-axis test of [`Scene::area_takes`]). Otherwise the
+/// fallback BVH answers the rest of the segment. Every answer equals the brute-force one.
 ///
 /// The trees `T` are binary [`Bvh`]s as built; [`Scene::widen`] turns every one into a
 /// [`WideBvh`] (4-wide nodes, the faster traversal) with the same answers.

@@ -197,9 +197,18 @@ mod tests {
 
     #[test]
     fn the_octree_levels_help_says_the_default() {
-        // `--octree-levels` is an Option (so `--lookup list` can refuse it), and its help
-        // spells the default out.
-        assert_eq!(rdbvh_core::toplevel::DEFAULT_OCTREE_LEVELS, 5);
+        // `--octree-levels` is an Option (so `--lookup list` can refuse it), so clap cannot show
+        // its default: the help spells it out, and must say the one the code uses.
+        use clap::CommandFactory;
+        let cli = super::super::Cli::command();
+        let trace = cli.find_subcommand("trace").unwrap();
+        let arg = trace
+            .get_arguments()
+            .find(|a| a.get_id() == "octree_levels")
+            .unwrap();
+        let help = arg.get_help().unwrap().to_string();
+        let default = rdbvh_core::toplevel::DEFAULT_OCTREE_LEVELS;
+        assert!(help.contains(&format!("[default: {default}]")), "{help}");
     }
 
     #[test]

@@ -224,6 +224,64 @@ fn two_configuration_experiment_end_to_end() {
     let csv = std::fs::read_to_string(&nodes).unwrap();
     assert!(csv.starts_with("index,depth,count\n0,0,0\n"), "{csv}");
 
+    // The JSON export holds every CSV column under the same name, with the same values.
+    let all = dir.join("nodes_all.csv");
+    let json = dir.join("nodes.json");
+    for export in [&all, &json] {
+        let o = rdbvh(&[
+            "analyze",
+            dir.join("scenes/Grid.obj").to_str().unwrap(),
+            "--areas",
+            file.to_str().unwrap(),
+            "--rays",
+            "8",
+            "--nodes",
+            export.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let csv = std::fs::read_to_string(&all).unwrap();
+    let mut rows = csv.lines();
+    let header: Vec<&str> = rows.next().unwrap().split(',').collect();
+    assert_eq!(header, rdbvh::cli::NODE_COLUMNS);
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let records = v["nodes"].as_array().unwrap();
+    let rows: Vec<&str> = rows.collect();
+    assert_eq!(records.len(), rows.len());
+    let mut leaf_prims = 0;
+    for (record, row) in records.iter().zip(&rows) {
+        let record = record.as_object().unwrap();
+        let keys: Vec<&str> = record.keys().map(|k| k.as_str()).collect();
+        let mut columns = header.clone();
+        columns.sort_unstable();
+        assert_eq!(keys, columns);
+        for (column, cell) in header.iter().zip(row.split(',')) {
+            let value = &record[*column];
+            let same = match value {
+                serde_json::Value::Null => cell.is_empty(),
+                serde_json::Value::Bool(b) => cell == b.to_string(),
+                // The CSV writes f32s shortest; JSON the same f32 through f64.
+                n => n.as_f64().unwrap() as f32 == cell.parse::<f32>().unwrap(),
+            };
+            assert!(same, "{column}: {value} vs {cell}");
+        }
+        let f = |k: &str| record[k].as_f64().unwrap();
+        let e = [
+            f("max_x") - f("min_x"),
+            f("max_y") - f("min_y"),
+            f("max_z") - f("min_z"),
+        ];
+        let half = e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+        assert!((f("measure") - half).abs() <= 1e-5 * half.max(1.0));
+        assert!((f("area") - 2.0 * half).abs() <= 1e-5 * half.max(1.0));
+        if record["is_leaf"].as_bool().unwrap() {
+            leaf_prims += record["count"].as_u64().unwrap();
+        }
+    }
+    // Every triangle of the first area's local BVH sits in one leaf.
+    assert_eq!(leaf_prims, areas[0]["local_triangles"].as_u64().unwrap());
+
     // Bad input: one line, non-zero exit.
     let o = rdbvh(&[
         "experiment",

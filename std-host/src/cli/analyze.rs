@@ -56,7 +56,9 @@ pub struct AnalyzeArgs {
     #[arg(long)]
     pub json: bool,
     /// Export the first area's local BVH per node: JSON (whole tree) for a `.json` file, CSV
-    /// otherwise.
+    /// otherwise. Both hold the --columns fields under the same names: `measure` is the node's
+    /// SAH measure (half its surface area), `hit_probability` that over its parent's, `area` its
+    /// surface area; `parent` is empty (CSV) or null (JSON) at the root.
     #[arg(long, value_name = "FILE")]
     pub nodes: Option<PathBuf>,
     /// CSV columns for --nodes, comma-separated (default: all of index, parent, depth, min_x,
@@ -188,29 +190,59 @@ fn metrics_json(area: usize, kind: &str, m: &RunMetrics, error: f32) -> Value {
     Value::Object(o)
 }
 
-fn node_field(r: &NodeRecord, col: &str) -> String {
+/// One field of a node export, typed so the CSV and the JSON export write the same values.
+enum Field {
+    Int(u32),
+    Real(f32),
+    Flag(bool),
+    Missing,
+}
+
+/// Column `col` (one of [`NODE_COLUMNS`]) of node `r`; both exports take every value from here.
+fn node_field(r: &NodeRecord, col: &str) -> Field {
     match col {
-        "index" => r.index.to_string(),
-        "parent" => {
-            if r.parent == u32::MAX {
-                String::new()
-            } else {
-                r.parent.to_string()
-            }
+        "index" => Field::Int(r.index),
+        "parent" if r.parent == u32::MAX => Field::Missing,
+        "parent" => Field::Int(r.parent),
+        "depth" => Field::Int(r.depth),
+        "min_x" => Field::Real(r.min[0]),
+        "min_y" => Field::Real(r.min[1]),
+        "min_z" => Field::Real(r.min[2]),
+        "max_x" => Field::Real(r.max[0]),
+        "max_y" => Field::Real(r.max[1]),
+        "max_z" => Field::Real(r.max[2]),
+        "count" => Field::Int(r.count),
+        "left_first" => Field::Int(r.left_first),
+        "measure" => Field::Real(r.measure),
+        "hit_probability" => Field::Real(r.hit_probability),
+        "is_leaf" => Field::Flag(r.count > 0),
+        "area" => {
+            let e = glam::Vec3::from(r.max) - glam::Vec3::from(r.min);
+            Field::Real(2.0 * (e.x * e.y + e.y * e.z + e.z * e.x))
         }
-        "depth" => r.depth.to_string(),
-        "min_x" => r.min[0].to_string(),
-        "min_y" => r.min[1].to_string(),
-        "min_z" => r.min[2].to_string(),
-        "max_x" => r.max[0].to_string(),
-        "max_y" => r.max[1].to_string(),
-        "max_z" => r.max[2].to_string(),
-        "count" => r.count.to_string(),
-        "left_first" => r.left_first.to_string(),
-        "measure" => r.measure.to_string(),
-        "hit_probability" => r.hit_probability.to_string(),
-        "is_leaf" => (r.count > 0).to_string(),
-        _ => String::new(),
+        _ => Field::Missing,
+    }
+}
+
+impl Field {
+    /// The CSV cell: empty for a missing value (the root's parent).
+    fn csv(&self) -> String {
+        match self {
+            Field::Int(v) => v.to_string(),
+            Field::Real(v) => v.to_string(),
+            Field::Flag(v) => v.to_string(),
+            Field::Missing => String::new(),
+        }
+    }
+
+    /// The JSON value: `null` for a missing value.
+    fn json(&self) -> Value {
+        match self {
+            Field::Int(v) => json!(v),
+            Field::Real(v) => json!(v),
+            Field::Flag(v) => json!(v),
+            Field::Missing => Value::Null,
+        }
     }
 }
 
@@ -233,13 +265,10 @@ fn write_nodes(
         let nodes: Vec<Value> = records
             .iter()
             .map(|r| {
-                json!({
-                    "index": r.index,
-                    "parent": (r.parent != u32::MAX).then_some(r.parent),
-                    "depth": r.depth, "min": r.min, "max": r.max, "count": r.count,
-                    "left_first": r.left_first, "sah_measure": r.measure,
-                    "hit_probability": r.hit_probability,
-                })
+                let fields = NODE_COLUMNS
+                    .iter()
+                    .map(|&c| (c.to_string(), node_field(r, c).json()));
+                Value::Object(fields.collect())
             })
             .collect();
         let text = serde_json::to_string(&json!({ "nodes": nodes }))
@@ -259,17 +288,7 @@ fn write_nodes(
     let mut text = cols.join(",");
     text.push('\n');
     for r in records {
-        let row: Vec<String> = cols
-            .iter()
-            .map(|c| {
-                if c == "area" {
-                    let e = glam::Vec3::from(r.max) - glam::Vec3::from(r.min);
-                    (2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)).to_string()
-                } else {
-                    node_field(r, c)
-                }
-            })
-            .collect();
+        let row: Vec<String> = cols.iter().map(|c| node_field(r, c).csv()).collect();
         text.push_str(&row.join(","));
         text.push('\n');
     }

@@ -7,7 +7,8 @@ use glam::{Vec2, Vec3};
 
 use crate::bvh::Bvh;
 use crate::geometry::{
-    orthographic_silhouette, perspective_silhouette, Aabb, ConvexPolygon, Frame, MAX_POLY,
+    orthographic_silhouette, perspective_silhouette, perspective_window_silhouette, Aabb,
+    ConvexPolygon, Frame, MAX_POLY,
 };
 use crate::influence::InfluenceArea;
 
@@ -24,8 +25,11 @@ pub enum OverlapSpace {
     /// Orthographic projection along a plane area's rays, onto its light plane: the area of the
     /// intersection of the two projections over the smaller projection. With a window, both
     /// projections are first clipped to the light rectangle `[lo, hi]` (in `(right, up)`
-    /// coordinates).
+    /// coordinates about `origin`).
     Ortho {
+        /// The point boxes are taken relative to before they are projected (the light's centre):
+        /// a small window far from the world origin keeps its precision.
+        origin: Vec3,
         /// Projection axes.
         right: Vec3,
         /// Projection axes.
@@ -54,12 +58,12 @@ impl OverlapSpace {
     pub fn projected(area: &InfluenceArea, culled: bool) -> Self {
         match area {
             InfluenceArea::Plane(a) => {
-                let c = Vec2::new(a.center.dot(a.frame.right), a.center.dot(a.frame.up));
                 let h = Vec2::new(a.half_width, a.half_height);
                 OverlapSpace::Ortho {
+                    origin: a.center,
                     right: a.frame.right,
                     up: a.frame.up,
-                    window: culled.then_some((c - h, c + h)),
+                    window: culled.then_some((-h, h)),
                 }
             }
             InfluenceArea::Point(a) => {
@@ -67,7 +71,7 @@ impl OverlapSpace {
                 OverlapSpace::Perspective {
                     eye: f.eye,
                     frame: f.frame,
-                    near: f.near.max(1e-6 * f.far),
+                    near: f.near,
                     window: culled.then_some(Vec2::new(f.tan_x, f.tan_y)),
                 }
             }
@@ -88,9 +92,15 @@ impl OverlapSpace {
                 };
                 (vol(a), vol(b), vol(&a.intersection(*b)))
             }
-            OverlapSpace::Ortho { right, up, window } => {
+            OverlapSpace::Ortho {
+                origin,
+                right,
+                up,
+                window,
+            } => {
                 let project = |x: &Aabb| {
-                    let hull = orthographic_silhouette(x, right, up);
+                    let relative = Aabb::new(x.min - origin, x.max - origin);
+                    let hull = orthographic_silhouette(&relative, right, up);
                     match window {
                         Some((lo, hi)) => hull.clip_to_rect(lo, hi),
                         None => hull,
@@ -105,12 +115,11 @@ impl OverlapSpace {
                 near,
                 window,
             } => {
-                let project = |x: &Aabb| {
-                    let hull = perspective_silhouette(x, eye, &frame, near);
-                    match window {
-                        Some(t) => hull.clip_to_rect(-t, t),
-                        None => hull,
+                let project = |x: &Aabb| match window {
+                    Some(t) => {
+                        perspective_window_silhouette(x, eye, &frame, near, t).clip_to_rect(-t, t)
                     }
+                    None => perspective_silhouette(x, eye, &frame, near),
                 };
                 let (pa, pb) = (project(a), project(b));
                 (pa.area(), pb.area(), convex_intersection_area(&pa, &pb))

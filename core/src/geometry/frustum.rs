@@ -51,6 +51,13 @@ impl Frustum {
         })
     }
 
+    /// True when direction `d` (any length) leaves the eye through the window: within both fields
+    /// of view and in front of the eye.
+    pub fn sees_direction(&self, d: Vec3) -> bool {
+        let l = self.frame.to_local(d);
+        l.z > 0.0 && l.x.abs() <= self.tan_x * l.z && l.y.abs() <= self.tan_y * l.z
+    }
+
     /// The frustum as a polytope: near, far and four side planes; 8 corners; 5 face normals; 6
     /// edge directions (`right`, `up`, and the four corner rays).
     pub fn polytope(&self) -> Polytope {

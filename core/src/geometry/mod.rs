@@ -20,7 +20,9 @@ pub use frame::Frame;
 pub use frustum::Frustum;
 pub use obb::Obb;
 pub use polygon::{ConvexPolygon, MAX_POLY};
-pub use projection::{box_corner, orthographic_silhouette, perspective_silhouette};
+pub use projection::{
+    box_corner, orthographic_silhouette, perspective_silhouette, perspective_window_silhouette,
+};
 pub use ray::{Ray, RayError};
 pub use solid_angle::{box_solid_angle4, box_solid_angle_far4, far_field4, FAR_FIELD};
 pub use triangle::{Triangle, TriangleHit};

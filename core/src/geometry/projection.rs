@@ -24,12 +24,27 @@ pub fn orthographic_silhouette(b: &Aabb, right: Vec3, up: Vec3) -> ConvexPolygon
     ConvexPolygon::hull(&corners)
 }
 
+/// The nearest depth [`perspective_silhouette`] projects, relative to the box's largest
+/// eye-relative coordinate: `2^-20`.
+pub const MIN_RELATIVE_DEPTH: f32 = 1.0 / (1u32 << 20) as f32;
+
 /// The perspective silhouette, on the image plane `z = 1` of `frame` with its eye at `eye`, of the
-/// part of `b` at least `near > 0` in front of the eye. The silhouette of a convex body from a
+/// part of `b` at least `near >= 0` in front of the eye. The silhouette of a convex body from a
 /// point in front of it is the hull of its projected vertices: the box's corners beyond the near
 /// plane and the points where its 12 edges cross it, at most 14 points.
+///
+/// The cut is at least [`MIN_RELATIVE_DEPTH`] times the box's largest eye-relative coordinate
+/// from the eye, so no projected point lies farther than `1 / MIN_RELATIVE_DEPTH` from the axis
+/// and the hull's arithmetic stays far from overflow however small `near` is (0 included). That
+/// floor follows the box, not the frustum's depth: a floor from `far` once cut away a whole
+/// scene 0.3 units from the eye of a frustum 3e5 deep. It changes the silhouette only when the
+/// eye lies within that fraction of the box's size from the box.
 pub fn perspective_silhouette(b: &Aabb, eye: Vec3, frame: &Frame, near: f32) -> ConvexPolygon {
     let local: [Vec3; 8] = core::array::from_fn(|i| frame.to_local(box_corner(b, i) - eye));
+    let reach = local
+        .iter()
+        .fold(0.0f32, |m, p| m.max(p.abs().max_element()));
+    let near = near.max(MIN_RELATIVE_DEPTH * reach).max(f32::MIN_POSITIVE);
     let mut pts = [Vec2::ZERO; MAX_POLY];
     let mut n = 0;
     let project = |p: Vec3| Vec2::new(p.x / p.z, p.y / p.z);
@@ -60,4 +75,102 @@ pub fn perspective_silhouette(b: &Aabb, eye: Vec3, frame: &Frame, near: f32) -> 
         }
     }
     ConvexPolygon::hull(&pts[..n])
+}
+
+/// The perspective silhouette of the part of `b` at least `near >= 0` in front of the eye and
+/// inside the pyramid of half-angle tangents `tan` (the light's window), on the image plane
+/// `z = 1`: the box is clipped in 3D before anything is projected. Each of its six faces is
+/// clipped (Sutherland-Hodgman) by the near plane and the pyramid's four side planes; the
+/// clipped faces' vertices are the clipped solid's, and all of them project into the window, so
+/// no projected point is large whatever `near` is (0 included). Projecting first and clipping
+/// the hull to the window instead loses the window's precision to the long edges of points
+/// near the eye plane (a few 1e-4 of the measure with `near` 0).
+pub fn perspective_window_silhouette(
+    b: &Aabb,
+    eye: Vec3,
+    frame: &Frame,
+    near: f32,
+    tan: Vec2,
+) -> ConvexPolygon {
+    let local: [Vec3; 8] = core::array::from_fn(|i| frame.to_local(box_corner(b, i) - eye));
+    // Signed distances to the five planes, positive inside.
+    let planes: [fn(Vec3, Vec2, f32) -> f32; 5] = [
+        |p: Vec3, _: Vec2, near: f32| p.z - near,
+        |p: Vec3, t: Vec2, _: f32| t.x * p.z - p.x,
+        |p: Vec3, t: Vec2, _: f32| t.x * p.z + p.x,
+        |p: Vec3, t: Vec2, _: f32| t.y * p.z - p.y,
+        |p: Vec3, t: Vec2, _: f32| t.y * p.z + p.y,
+    ];
+    // Points gathered for the hull; when they would overflow the hull's input, the hull of those
+    // so far (a subset of them) takes their place.
+    let mut pts = [Vec2::ZERO; MAX_POLY];
+    let mut n = 0;
+    for (axis, other) in [(1usize, [2usize, 4]), (2, [4, 1]), (4, [1, 2])] {
+        for side in [0, axis] {
+            // The face's corners in cyclic order.
+            let [u, v] = other;
+            let mut face = [Vec3::ZERO; FACE_CLIP_MAX];
+            for (k, bits) in [0, u, u | v, v].into_iter().enumerate() {
+                face[k] = local[side | bits];
+            }
+            let mut len = 4;
+            for plane in planes {
+                len = clip_face(&mut face, len, |p| plane(p, tan, near));
+                if len == 0 {
+                    break;
+                }
+            }
+            for p in &face[..len] {
+                if p.z <= 0.0 {
+                    // The apex itself (near 0): it projects nowhere, and the rest of the
+                    // clipped solid already spans every direction it holds.
+                    continue;
+                }
+                let q = Vec2::new(p.x / p.z, p.y / p.z);
+                // A vertex of the solid is on three faces: keep it once.
+                if pts[..n]
+                    .iter()
+                    .any(|&r| (q - r).abs().max_element() <= 1e-6)
+                {
+                    continue;
+                }
+                if n == MAX_POLY {
+                    let hull = ConvexPolygon::hull(&pts);
+                    n = hull.points().len();
+                    pts[..n].copy_from_slice(hull.points());
+                }
+                // The solid's silhouette has at most one vertex per face of it (eleven), so a
+                // hull of distinct points always leaves room.
+                if n < MAX_POLY {
+                    pts[n] = q;
+                    n += 1;
+                }
+            }
+        }
+    }
+    ConvexPolygon::hull(&pts[..n])
+}
+
+/// The most vertices a box face has while [`perspective_window_silhouette`] clips it: four,
+/// plus one per clipping plane.
+const FACE_CLIP_MAX: usize = 4 + 5;
+
+/// Clips the convex polygon `face[..len]` to `inside(p) >= 0` in place; returns its new length.
+fn clip_face(face: &mut [Vec3; FACE_CLIP_MAX], len: usize, inside: impl Fn(Vec3) -> f32) -> usize {
+    let mut out = [Vec3::ZERO; FACE_CLIP_MAX];
+    let mut m = 0;
+    for i in 0..len {
+        let (a, c) = (face[i], face[(i + 1) % len]);
+        let (da, dc) = (inside(a), inside(c));
+        if da >= 0.0 && m < FACE_CLIP_MAX {
+            out[m] = a;
+            m += 1;
+        }
+        if (da >= 0.0) != (dc >= 0.0) && m < FACE_CLIP_MAX {
+            out[m] = a + (c - a) * (da / (da - dc));
+            m += 1;
+        }
+    }
+    *face = out;
+    m
 }

@@ -10,9 +10,13 @@ use crate::simd::Aabb4;
 
 use super::CostModel;
 
-/// The light rectangle in its own `(right, up)` coordinates.
+/// The light rectangle in its own `(right, up)` coordinates about its centre `origin`: boxes are
+/// taken relative to the centre before they are projected, so a small window far from the world
+/// origin keeps its precision (projected world coordinates round at `|centre| * 2^-24`, which a
+/// window a few 1e-7 across at 0.3 units from the origin cannot afford).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Window {
+    origin: Vec3,
     right: Vec3,
     up: Vec3,
     lo: Vec2,
@@ -56,18 +60,15 @@ impl PahOrtho {
 
     /// The rays of a plane area: its normal, culled to its light rectangle.
     pub fn for_area(area: &PlaneArea) -> Self {
-        let c = Vec2::new(
-            area.center.dot(area.frame.right),
-            area.center.dot(area.frame.up),
-        );
         let h = Vec2::new(area.half_width, area.half_height);
         Self {
             weights: area.frame.forward.abs(),
             window: Some(Window {
+                origin: area.center,
                 right: area.frame.right,
                 up: area.frame.up,
-                lo: c - h,
-                hi: c + h,
+                lo: -h,
+                hi: h,
             }),
         }
     }
@@ -109,7 +110,8 @@ impl PahOrtho {
     /// window axis the projection spans the centre's coordinate +- the sum of `|axis_k| e_k / 2`.
     #[inline]
     fn window_span(w: &Window, b: &Aabb) -> (Vec2, Vec2) {
-        let (c, h) = (b.center(), b.extent() * 0.5);
+        let (lo, hi) = (b.min - w.origin, b.max - w.origin);
+        let (c, h) = ((lo + hi) * 0.5, b.extent() * 0.5);
         let centre = Vec2::new(c.dot(w.right), c.dot(w.up));
         let half = Vec2::new(h.dot(w.right.abs()), h.dot(w.up.abs()));
         (centre - half, centre + half)
@@ -118,7 +120,8 @@ impl PahOrtho {
     /// The exact projected area of `b` inside the window `w`: hull of the eight projected
     /// corners, clipped to the rectangle.
     fn clipped_area(w: &Window, b: &Aabb) -> f32 {
-        orthographic_silhouette(b, w.right, w.up)
+        let relative = Aabb::new(b.min - w.origin, b.max - w.origin);
+        orthographic_silhouette(&relative, w.right, w.up)
             .clip_to_rect(w.lo, w.hi)
             .area()
     }
@@ -155,11 +158,9 @@ impl CostModel for PahOrtho {
         };
         let [ex, ey, ez] = b.extent();
         let half = f32x4::splat(0.5);
-        let c = [
-            (b.min[0] + b.max[0]) * half,
-            (b.min[1] + b.max[1]) * half,
-            (b.min[2] + b.max[2]) * half,
-        ];
+        let o = [win.origin.x, win.origin.y, win.origin.z].map(f32x4::splat);
+        let c: [f32x4; 3] =
+            core::array::from_fn(|k| ((b.min[k] - o[k]) + (b.max[k] - o[k])) * half);
         let h = [ex * half, ey * half, ez * half];
         let dot = |v: &[f32x4; 3], a: Vec3| {
             v[0] * f32x4::splat(a.x) + v[1] * f32x4::splat(a.y) + v[2] * f32x4::splat(a.z)
@@ -234,6 +235,40 @@ mod tests {
             rng.range(0.0, 3.0),
         );
         Aabb::new(a, a + e)
+    }
+
+    #[test]
+    fn small_windows_far_from_the_origin_keep_their_precision() {
+        // A window a few 1e-7 across, 0.3 from the origin, where projected world coordinates
+        // round at 3e-8: a box covering it measures the whole window, one beside it nothing, one
+        // over half of it half, whatever the window's size.
+        for half in [1e-2f32, 1e-6, 3e-7, 1e-7, 1e-8, 1e-10, 1e-15] {
+            let centre = Vec3::new(-0.017, 0.30, -0.002);
+            let area = PlaneArea::new(centre, -Vec3::Y, half, half, 0.3).unwrap();
+            let pah = PahOrtho::for_area(&area);
+            let window = pah.window_measure().unwrap();
+            assert_eq!(window, 4.0 * half * half);
+            let covering = Aabb::new(Vec3::new(-0.1, 0.0, -0.1), Vec3::new(0.1, 0.2, 0.1));
+            // Past the window's edge, or the next f32 past its centre when the window is
+            // narrower than f32's spacing there.
+            let beside = Aabb::new(
+                Vec3::new((centre.x + 2.0 * half).max(centre.x.next_up()), 0.0, -0.1),
+                Vec3::new(0.1, 0.2, 0.1),
+            );
+            // The window's right is world -x or +x: either way this box covers one half of it.
+            let halfway = Aabb::new(Vec3::new(centre.x, 0.0, -0.1), Vec3::new(0.1, 0.2, 0.1));
+            let four = Aabb4::from_boxes([covering, beside, halfway, covering]);
+            for (j, m) in pah.measure4(&four).to_array().into_iter().enumerate() {
+                assert_eq!(m, pah.measure(&four.lane(j)), "lane {j}");
+            }
+            assert!(
+                (pah.measure(&covering) / window - 1.0).abs() < 1e-5,
+                "{half}"
+            );
+            assert_eq!(pah.measure(&beside), 0.0, "{half}");
+            let h = pah.measure(&halfway) / window;
+            assert!((h - 0.5).abs() < 0.05, "{half}: {h}");
+        }
     }
 
     #[test]

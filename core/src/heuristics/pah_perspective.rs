@@ -5,8 +5,8 @@ use glam::{Vec2, Vec3};
 use wide::f32x4;
 
 use crate::geometry::{
-    box_solid_angle4, box_solid_angle_far4, far_field4, perspective_silhouette, Aabb,
-    ConvexPolygon, Frame, FAR_FIELD,
+    box_solid_angle4, box_solid_angle_far4, far_field4, perspective_silhouette,
+    perspective_window_silhouette, Aabb, ConvexPolygon, Frame, FAR_FIELD,
 };
 use crate::influence::PointArea;
 use crate::simd::Aabb4;
@@ -86,8 +86,9 @@ impl PahPerspective {
     /// The rays of a point area, with the given measure, culled to its fields of view.
     pub fn for_area(area: &PointArea, measure: PerspectiveMeasure) -> Self {
         let f = area.frustum();
-        // A positive cut keeps every projected point finite when near is 0.
-        let near = f.near.max(1e-6 * f.far);
+        // The hull path floors its own cut relative to each box (`perspective_silhouette`); the
+        // 4-wide paths only need a box wholly in front of the eye to be strictly in front of it.
+        let near = f.near.max(f32::MIN_POSITIVE);
         Self {
             eye: f.eye,
             frame: f.frame,
@@ -132,11 +133,14 @@ impl PahPerspective {
         if b.is_empty() {
             return 0.0;
         }
-        let mut poly = self.silhouette(b);
-        if self.cull {
+        let poly = if self.cull {
+            // Clipped to the window in 3D, then to the rectangle for the rounding.
             let t = Vec2::new(self.tan_x, self.tan_y);
-            poly = poly.clip_to_rect(-t, t);
-        }
+            perspective_window_silhouette(b, self.eye, &self.frame, self.near, t)
+                .clip_to_rect(-t, t)
+        } else {
+            self.silhouette(b)
+        };
         match self.measure {
             PerspectiveMeasure::SolidAngle => poly.solid_angle_on_image_plane(),
             PerspectiveMeasure::ImagePlane => poly.area(),
@@ -484,6 +488,46 @@ mod tests {
             }
         }
         assert!(checked > 2000, "the fast path ran {checked} times");
+    }
+
+    #[test]
+    fn the_frustum_depth_and_a_zero_near_do_not_cut_boxes_beyond_near() {
+        // A frustum's far distance bounds where its rays go, not what its measure may ignore: a
+        // floor on the cut from `far` once zeroed every box of a scene 0.3 from the eye.
+        let eye = Vec3::new(-0.017, 0.11, 0.3);
+        let area = |near: f32, far: f32| PointArea::new(eye, -Vec3::Z, 60.0, 60.0, near, far);
+        let mut rng = crate::random::Pcg32::new(9);
+        for m in [
+            PerspectiveMeasure::SolidAngle,
+            PerspectiveMeasure::ImagePlane,
+        ] {
+            let reference = PahPerspective::for_area(&area(0.01, 1.0).unwrap(), m);
+            for far in [1e5, 1e10, 1e17] {
+                let deep = PahPerspective::for_area(&area(0.01, far).unwrap(), m);
+                let zero = PahPerspective::for_area(&area(0.0, far).unwrap(), m);
+                for _ in 0..500 {
+                    // Boxes around the scene, some straddling the window or holding the eye.
+                    let lo = eye
+                        + Vec3::new(
+                            rng.range(-0.2, 0.1),
+                            rng.range(-0.2, 0.1),
+                            rng.range(-0.4, 0.05),
+                        );
+                    let hi = lo + Vec3::splat(rng.range(0.001, 0.3));
+                    let b = Aabb::new(lo, hi);
+                    let r = reference.measure(&b);
+                    assert_eq!(deep.measure(&b), r, "far {far}, {b:?}");
+                    let z = zero.measure(&b);
+                    assert!(z.is_finite() && z >= 0.0, "{z} for {b:?}");
+                    // From the eye instead of 0.01 in front of it: the same where the box lies
+                    // wholly beyond 0.01, never less.
+                    if b.max.z < eye.z - 0.01 {
+                        assert!((z - r).abs() <= 1e-5 * r.max(1e-3), "{z} vs {r}: {b:?}");
+                    }
+                    assert!(z >= r * (1.0 - 1e-5), "{z} vs {r}: {b:?}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -21,7 +21,15 @@ pub enum AreaError {
     /// The area reaches farther than [`MAX_AREA_COORDINATE`] from the origin: products of its
     /// coordinates would overflow `f32`, and its planes would lose the box to rounding.
     TooLarge(&'static str),
+    /// The light's window is too small for `f32` measures: its area (plane) or its image-plane
+    /// area `4 tan_x tan_y` (point) is below [`MIN_WINDOW_MEASURE`].
+    TooSmall(&'static str),
 }
+
+/// The smallest window measure an area may have, `2^-100` (about 7.9e-31): the measures of the
+/// boxes inside it, down to `2^-24` of it, then stay normal `f32`s. Below it they round to
+/// subnormals and zero, and every PAH cost over the window reads zero.
+pub const MIN_WINDOW_MEASURE: f32 = 1.0 / (1u128 << 100) as f32;
 
 /// How far from the origin an influence area may reach, per coordinate. Its plane offsets and
 /// separating-axis projections multiply coordinates, and `1e18` squared stays well inside `f32`.
@@ -40,6 +48,11 @@ impl fmt::Display for AreaError {
             AreaError::Tolerance => {
                 f.write_str("the affinity tolerance must be within [0, 180) degrees")
             }
+            AreaError::TooSmall(key) => write!(
+                f,
+                "`{key}` makes the light's window too small for f32 measures (its area must be \
+                 at least 2^-100, about 7.9e-31)"
+            ),
             AreaError::TooLarge(key) => write!(
                 f,
                 "`{key}` puts the area more than 1e18 units from the origin, beyond what f32 \

@@ -13,7 +13,7 @@ mod point;
 mod sampler;
 
 pub use area::InfluenceArea;
-pub use error::{AreaError, MAX_AREA_COORDINATE};
+pub use error::{AreaError, MAX_AREA_COORDINATE, MIN_WINDOW_MEASURE};
 pub use plane::PlaneArea;
 pub use point::PointArea;
 pub use sampler::{PointDistribution, RaySampler};

@@ -3,7 +3,7 @@
 use glam::Vec3;
 
 use super::error::{cos_tolerance, finite3, positive};
-use super::{AreaError, DEFAULT_AFFINITY_DEG, MAX_AREA_COORDINATE};
+use super::{AreaError, DEFAULT_AFFINITY_DEG, MAX_AREA_COORDINATE, MIN_WINDOW_MEASURE};
 use crate::geometry::{Aabb, Frame, Obb, Polytope, Ray, Triangle};
 
 /// An oriented box: the light rectangle (centre `center`, half extents `half_width` along
@@ -42,6 +42,14 @@ impl PlaneArea {
         let half_width = positive(half_width, "half_width")?;
         let half_height = positive(half_height, "half_height")?;
         let depth = positive(depth, "depth")?;
+        if !(4.0 * half_width * half_height >= MIN_WINDOW_MEASURE) {
+            let key = if half_width < half_height {
+                "half_width"
+            } else {
+                "half_height"
+            };
+            return Err(AreaError::TooSmall(key));
+        }
         let obb = Obb::new(
             center + frame.forward * (0.5 * depth),
             frame,
@@ -179,5 +187,11 @@ mod tests {
             Err(AreaError::NotFinite("center"))
         );
         assert_eq!(area().with_tolerance_deg(180.0), Err(AreaError::Tolerance));
+        // A window whose area underflows f32's normal range cannot be measured.
+        assert_eq!(
+            PlaneArea::new(c, Vec3::Z, 1e-16, 1e-15, 1.0),
+            Err(AreaError::TooSmall("half_width"))
+        );
+        assert!(PlaneArea::new(c, Vec3::Z, 1e-15, 1e-15, 1.0).is_ok());
     }
 }

@@ -3,8 +3,14 @@
 use glam::Vec3;
 
 use super::error::{cos_tolerance, finite3};
-use super::{AreaError, DEFAULT_AFFINITY_DEG, MAX_AREA_COORDINATE};
+use super::{AreaError, DEFAULT_AFFINITY_DEG, MAX_AREA_COORDINATE, MIN_WINDOW_MEASURE};
 use crate::geometry::{Aabb, Frame, Frustum, Polytope, Ray, Triangle};
+
+/// How close to the eye, relative to the coordinates' magnitude, an origin counts as the eye
+/// itself for [`PointArea::is_affine`]: `1024 f32::EPSILON`. Beyond it the origin's rounding
+/// turns the direction from the eye by at most 1/1024 radian (0.06 degrees), well inside the
+/// affinity tolerance.
+const EYE_ROUNDING: f32 = 1024.0 * f32::EPSILON;
 
 /// A frustum with apex at the light (`eye`), looking along `frame.forward`, full fields of view
 /// `fov_x_deg` (along `frame.right`) and `fov_y_deg` (along `frame.up`), cut at `near` and `far`.
@@ -47,6 +53,14 @@ impl PointArea {
         };
         let tan_x = tan_half(fov_x_deg, "fov_x_deg")?;
         let tan_y = tan_half(fov_y_deg, "fov_y_deg")?;
+        if !(4.0 * tan_x * tan_y >= MIN_WINDOW_MEASURE) {
+            let key = if tan_x < tan_y {
+                "fov_x_deg"
+            } else {
+                "fov_y_deg"
+            };
+            return Err(AreaError::TooSmall(key));
+        }
         if !near.is_finite() {
             return Err(AreaError::NotFinite("near"));
         }
@@ -121,12 +135,26 @@ impl PointArea {
     }
 
     /// Affinity: the origin is inside and the direction is within the tolerance of the radial
-    /// direction from the eye to the origin.
+    /// direction from the eye to the origin. At the eye itself, to rounding (the rays of an area
+    /// whose `near` is 0 or tiny start there), the direction from the eye means nothing: a ray
+    /// that leaves the eye through the window is radial.
     pub fn is_affine(&self, ray: &Ray) -> bool {
         let Some(d) = ray.dir.try_normalize() else {
             return false;
         };
-        d.dot(self.direction_at(ray.origin)) >= self.cos_tolerance && self.contains(ray.origin)
+        let f = &self.frustum;
+        let offset = ray.origin - f.eye;
+        let rounding = EYE_ROUNDING
+            * f.eye
+                .abs()
+                .max_element()
+                .max(ray.origin.abs().max_element());
+        let radial = match offset.try_normalize() {
+            Some(r) if offset.abs().max_element() > rounding => r,
+            _ if f.sees_direction(d) => d,
+            _ => return false,
+        };
+        d.dot(radial) >= self.cos_tolerance && self.contains(ray.origin)
     }
 }
 
@@ -160,6 +188,31 @@ mod tests {
         assert!(!a.is_affine(&Ray::new(o, Vec3::Z).unwrap()));
         let t = a.exit(&radial).unwrap();
         assert!((radial.at(t).z - 16.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn rays_from_the_eye_are_radial_when_near_is_zero_or_tiny() {
+        let eye = Vec3::new(-0.017, 0.11, 0.3);
+        for near in [0.0, 1e-8, 1e-7] {
+            let a = PointArea::new(eye, -Vec3::Z, 60.0, 60.0, near, 1.0).unwrap();
+            // Origins where the sampler puts them: on the near plane, rounded.
+            let mut inside = 0;
+            for i in 0..200 {
+                let (x, y) = ((i % 20) as f32 / 19.0 - 0.5, (i / 20) as f32 / 9.0 - 0.5);
+                let d = Vec3::new(x, y, -1.0);
+                let r = Ray::new(eye + d * near, d).unwrap();
+                assert!(a.is_affine(&r), "near {near}, direction {d}");
+                inside += 1;
+            }
+            assert_eq!(inside, 200);
+            // Leaving the eye outside the window (or backwards) is not radial to this area.
+            for d in [Vec3::new(0.9, 0.0, -1.0), Vec3::Z, Vec3::X] {
+                assert!(!a.is_affine(&Ray::new(eye, d).unwrap()), "{d}");
+            }
+        }
+        // With a real near plane the eye is outside the area.
+        let a = PointArea::new(eye, -Vec3::Z, 60.0, 60.0, 0.01, 1.0).unwrap();
+        assert!(!a.is_affine(&Ray::new(eye, -Vec3::Z).unwrap()));
     }
 
     #[test]

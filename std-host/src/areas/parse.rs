@@ -307,7 +307,7 @@ fn area_error_key(e: &AreaError) -> Option<&'static str> {
         | AreaError::ZeroDirection(k)
         | AreaError::FieldOfView(k) => Some(k),
         AreaError::NearFar => Some("near"),
-        AreaError::TooLarge(k) => Some(k),
+        AreaError::TooLarge(k) | AreaError::TooSmall(k) => Some(k),
         AreaError::Tolerance => None,
     }
 }

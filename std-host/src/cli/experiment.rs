@@ -41,7 +41,8 @@ pub struct ExperimentArgs {
     #[arg(long, value_name = "DIR")]
     pub thesis_results: Option<PathBuf>,
     /// Candidate planes per axis in thesis mode (overrides candidate_planes).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=255))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32)
+        .range(1..=i64::from(crate::experiment::MAX_CANDIDATE_PLANES)))]
     pub candidate_planes: Option<u32>,
     /// Largest leaf in thesis mode (overrides max_triangles_per_leaf).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]

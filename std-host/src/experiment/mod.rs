@@ -43,7 +43,7 @@ pub use error::ExperimentError;
 pub use plots::fonts_available;
 pub use results::{header, read_table, read_thesis_results, RunRow, Table, THESIS_COLUMNS};
 pub use run::{build_fallback, run_one, sample_rays, RunMetrics, RunSetup};
-pub use settings::{parse_presets, ExperimentFile, Settings};
+pub use settings::{parse_presets, ExperimentFile, Settings, MAX_CANDIDATE_PLANES};
 pub use summary::{cheaper_groups, findings, Findings, RunKey, GROUPS};
 
 use std::collections::HashMap;

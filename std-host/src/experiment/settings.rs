@@ -100,6 +100,85 @@ impl Settings {
         }
     }
 
+    /// Checks every value's range, as the command line checks its overrides, so a bad file is an
+    /// error naming its key and line rather than a failure of some later step (or a run that
+    /// quietly does something else). `text` is the file, to find the key's line.
+    fn check(&self, text: &str, path: &Path) -> Result<(), ExperimentError> {
+        let finite_non_negative = |x: f32| x.is_finite() && x >= 0.0;
+        let max_octree = rdbvh_core::toplevel::MAX_OCTREE_LEVELS;
+        let rules: [(&str, bool, String); 11] = [
+            (
+                "rays_per_config",
+                self.rays_per_config >= 1,
+                "must be at least 1".into(),
+            ),
+            (
+                "candidate_planes",
+                (1..=MAX_CANDIDATE_PLANES).contains(&self.candidate_planes),
+                format!(
+                    "must be between 1 and {MAX_CANDIDATE_PLANES} (planes + 1 bins, at most 64)"
+                ),
+            ),
+            (
+                "max_triangles_per_leaf",
+                self.max_triangles_per_leaf >= 1,
+                "must be at least 1".into(),
+            ),
+            (
+                "max_levels",
+                self.max_levels >= 1,
+                "must be at least 1".into(),
+            ),
+            (
+                "octree_levels",
+                (1..=max_octree).contains(&self.octree_levels),
+                format!("must be between 1 and {max_octree}"),
+            ),
+            (
+                "inner_node_cost",
+                finite_non_negative(self.inner_node_cost),
+                "must be finite and >= 0".into(),
+            ),
+            (
+                "triangle_cost",
+                self.triangle_cost.is_finite() && self.triangle_cost > 0.0,
+                "must be finite and > 0".into(),
+            ),
+            (
+                "spfh_quality_threshold",
+                finite_non_negative(self.spfh_quality_threshold),
+                "must be finite and >= 0".into(),
+            ),
+            (
+                "lsph_quality_threshold",
+                finite_non_negative(self.lsph_quality_threshold),
+                "must be finite and >= 0".into(),
+            ),
+            (
+                "acceptable_ratio",
+                finite_non_negative(self.acceptable_ratio),
+                "must be finite and >= 0".into(),
+            ),
+            (
+                "excellent_ratio",
+                finite_non_negative(self.excellent_ratio),
+                "must be finite and >= 0".into(),
+            ),
+        ];
+        match rules.into_iter().find(|(_, ok, _)| !ok) {
+            None => Ok(()),
+            Some((key, _, why)) => {
+                let line = settings_line(text, key)
+                    .map(|n| format!(" line {n}"))
+                    .unwrap_or_default();
+                Err(ExperimentError::Settings(format!(
+                    "{}{line}: `{key}` {why}",
+                    path.display()
+                )))
+            }
+        }
+    }
+
     /// The presets named in `heuristics`, checked.
     pub fn presets(&self) -> Result<Vec<Preset>, ExperimentError> {
         parse_presets(self.heuristics.iter().map(String::as_str))
@@ -126,6 +205,29 @@ pub fn parse_presets<'a>(
         return Err(ExperimentError::Settings("no heuristic to run".into()));
     }
     Ok(out)
+}
+
+/// The most candidate planes per axis `candidate_planes` (and `--candidate-planes`) may name: a
+/// node box gets one bin more than planes, and a sweep at most 64 bins.
+pub const MAX_CANDIDATE_PLANES: u32 = rdbvh_core::build::MAX_BINS - 1;
+
+/// The line (from 1) of `key = ...` in the file's `[settings]` table, if it is written there.
+fn settings_line(text: &str, key: &str) -> Option<usize> {
+    let mut in_settings = false;
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim_start();
+        if line.starts_with('[') {
+            in_settings = line.trim_end() == "[settings]";
+        } else if in_settings {
+            let is_key = line
+                .strip_prefix(key)
+                .is_some_and(|rest| rest.trim_start().starts_with('='));
+            if is_key {
+                return Some(i + 1);
+            }
+        }
+    }
+    None
 }
 
 #[derive(Deserialize)]
@@ -172,6 +274,7 @@ impl ExperimentFile {
                 e.message().lines().next().unwrap_or("invalid TOML")
             ))
         })?;
+        top.settings.check(text, path)?;
         let areas = parse_areas(text, path).map_err(|e| match e.kind {
             // The area files' wording names [[area]] tables first; an experiment lists configs.
             AreasErrorKind::NoAreas => ExperimentError::Areas(format!(
@@ -222,6 +325,23 @@ mod tests {
         let areas = text.replace("[[config]]", "[[area]]");
         let e = ExperimentFile::parse(&areas, Path::new("e.toml")).unwrap_err();
         assert!(e.to_string().contains("[[config]] tables"), "{e}");
+        // Values out of range name their key and line, as the command line's options do.
+        for (setting, key) in [
+            ("octree_levels = 50", "octree_levels"),
+            ("candidate_planes = 64", "candidate_planes"),
+            ("candidate_planes = 0", "candidate_planes"),
+            ("triangle_cost = -1.0", "triangle_cost"),
+            ("max_triangles_per_leaf = 0", "max_triangles_per_leaf"),
+            ("rays_per_config = 0", "rays_per_config"),
+            ("excellent_ratio = nan", "excellent_ratio"),
+        ] {
+            let bad = format!("[settings]\nheuristics = [\"sah\"]\n{setting}\n{text}");
+            let e = ExperimentFile::parse(&bad, Path::new("e.toml")).unwrap_err();
+            let e = e.to_string();
+            assert!(e.starts_with(&format!("e.toml line 3: `{key}` ")), "{e}");
+        }
+        let fine = format!("[settings]\ncandidate_planes = 63\noctree_levels = 10\n{text}");
+        assert!(ExperimentFile::parse(&fine, Path::new("e.toml")).is_ok());
         assert!(parse_presets(["full", "bogus"]).is_err());
         assert_eq!(
             parse_presets(["Full", "full", "standard"]).unwrap(),

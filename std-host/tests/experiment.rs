@@ -275,6 +275,11 @@ fn two_configuration_experiment_end_to_end() {
         let half = e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
         assert!((f("measure") - half).abs() <= 1e-5 * half.max(1.0));
         assert!((f("area") - 2.0 * half).abs() <= 1e-5 * half.max(1.0));
+        // Conditional probabilities, under SAH and under the area's PAH.
+        for p in [f("hit_probability"), f("pah_hit_probability")] {
+            assert!((0.0..=1.0 + 1e-5).contains(&p), "{p}");
+        }
+        assert!(f("pah_measure") >= 0.0);
         if record["is_leaf"].as_bool().unwrap() {
             leaf_prims += record["count"].as_u64().unwrap();
         }

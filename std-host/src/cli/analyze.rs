@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use rdbvh_core::analyze::{analyze, containment, NodeRecord, NodeRecords, THESIS_LEVELS};
-use rdbvh_core::build::Preset;
+use rdbvh_core::build::{AreaPah, Preset};
 use rdbvh_core::heuristics::Sah;
 use rdbvh_core::influence::InfluenceArea;
 use rdbvh_core::toplevel::Octree;
@@ -16,7 +16,7 @@ use super::{load_scene, CliError};
 use crate::experiment::{build_fallback, run_one, sample_rays, RunMetrics, RunSetup, Settings};
 
 /// The per-node columns `--nodes FILE.csv` can write.
-pub const NODE_COLUMNS: [&str; 15] = [
+pub const NODE_COLUMNS: [&str; 17] = [
     "index",
     "parent",
     "depth",
@@ -32,6 +32,8 @@ pub const NODE_COLUMNS: [&str; 15] = [
     "hit_probability",
     "is_leaf",
     "area",
+    "pah_measure",
+    "pah_hit_probability",
 ];
 
 /// Arguments of `rdbvh analyze`.
@@ -57,13 +59,17 @@ pub struct AnalyzeArgs {
     pub json: bool,
     /// Export the first area's local BVH per node: JSON (whole tree) for a `.json` file, CSV
     /// otherwise. Both hold the --columns fields under the same names: `measure` is the node's
-    /// SAH measure (half its surface area), `hit_probability` that over its parent's, `area` its
-    /// surface area; `parent` is empty (CSV) or null (JSON) at the root.
+    /// SAH measure (half its surface area), `hit_probability` that over its parent's (the chance
+    /// that a uniform ray through the parent enters it), `area` its surface area; `pah_measure`
+    /// is its measure under the area's PAH (projected area, or solid angle, inside the light's
+    /// window) and `pah_hit_probability` that over its parent's (the chance that one of the
+    /// area's rays through the parent enters it; 0 under a parent no such ray reaches); both
+    /// probabilities are 1 at the root; `parent` is empty (CSV) or null (JSON) at the root.
     #[arg(long, value_name = "FILE")]
     pub nodes: Option<PathBuf>,
     /// CSV columns for --nodes, comma-separated (default: all of index, parent, depth, min_x,
     /// min_y, min_z, max_x, max_y, max_z, count, left_first, measure, hit_probability, is_leaf,
-    /// area).
+    /// area, pah_measure, pah_hit_probability).
     #[arg(long, value_name = "a,b", value_delimiter = ',', requires = "nodes")]
     pub columns: Option<Vec<String>>,
 }
@@ -198,9 +204,18 @@ enum Field {
     Missing,
 }
 
-/// Column `col` (one of [`NODE_COLUMNS`]) of node `r`; both exports take every value from here.
-fn node_field(r: &NodeRecord, col: &str) -> Field {
+/// A node's records: under SAH, and under the area's PAH (the same node, other measures).
+struct NodeRow<'a> {
+    sah: &'a NodeRecord,
+    pah: &'a NodeRecord,
+}
+
+/// Column `col` (one of [`NODE_COLUMNS`]) of node `row`; both exports take every value from here.
+fn node_field(row: &NodeRow<'_>, col: &str) -> Field {
+    let r = row.sah;
     match col {
+        "pah_measure" => Field::Real(row.pah.measure),
+        "pah_hit_probability" => Field::Real(row.pah.hit_probability),
         "index" => Field::Int(r.index),
         "parent" if r.parent == u32::MAX => Field::Missing,
         "parent" => Field::Int(r.parent),
@@ -254,7 +269,7 @@ fn is_json(path: &Path) -> bool {
 
 fn write_nodes(
     path: &Path,
-    records: &[NodeRecord],
+    records: &[NodeRow<'_>],
     columns: Option<&[String]>,
 ) -> Result<(), CliError> {
     let fail = |e: std::io::Error| CliError::Write {
@@ -347,8 +362,14 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
                 preset
                     .build_into(Some(&entry.area), &setup.local, &mut arena, &mut bvh)
                     .map_err(|e| CliError::Usage(e.to_string()))?;
-                let records = analyze(&bvh, NodeRecords::new(Sah));
-                write_nodes(path, &records, args.columns.as_deref())?;
+                let pah = AreaPah::new(&entry.area, setup.local.perspective);
+                let (sah, pah) = analyze(&bvh, (NodeRecords::new(Sah), NodeRecords::new(pah)));
+                let rows: Vec<NodeRow<'_>> = sah
+                    .iter()
+                    .zip(&pah)
+                    .map(|(sah, pah)| NodeRow { sah, pah })
+                    .collect();
+                write_nodes(path, &rows, args.columns.as_deref())?;
             }
         }
         reports.push(metrics_json(entry.index + 1, kind, &m, c.error()));

@@ -40,14 +40,14 @@ pub struct ExperimentArgs {
     /// The thesis's results folder (its Plane_*.csv and Point_*.csv): shown beside ours.
     #[arg(long, value_name = "DIR")]
     pub thesis_results: Option<PathBuf>,
-    /// Candidate planes per axis in thesis mode (overrides candidate_planes).
+    /// Candidate planes per axis in thesis mode, 1 to 63 (overrides candidate_planes).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32)
         .range(1..=i64::from(crate::experiment::MAX_CANDIDATE_PLANES)))]
     pub candidate_planes: Option<u32>,
     /// Largest leaf in thesis mode (overrides max_triangles_per_leaf).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub max_leaf: Option<u32>,
-    /// Octree levels (overrides octree_levels).
+    /// Octree levels, 1 to 10 (overrides octree_levels).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10))]
     pub octree_levels: Option<u32>,
 }

@@ -78,6 +78,21 @@ fn build_json_has_the_contract_keys() {
     assert_eq!(nodes, 2 * leaves - 1, "a binary tree");
     assert_eq!(json["bytes"], nodes * 32 + 1000 * 4);
     assert!(json["sah_cost"].as_f64().unwrap() > 1.0);
+    // The help lists exactly these keys.
+    let help = text(&rdbvh(&["build", "--help"]).stdout).replace('\n', " ");
+    let listed = help
+        .split("--json prints one object with the keys ")
+        .nth(1)
+        .and_then(|rest| rest.split(" (null where").next())
+        .unwrap();
+    let mut listed: Vec<String> = listed
+        .split(", ")
+        .map(|k| k.split(' ').next().unwrap().to_string())
+        .collect();
+    listed.sort();
+    let mut keys: Vec<String> = json.as_object().unwrap().keys().cloned().collect();
+    keys.sort();
+    assert_eq!(listed, keys);
 }
 
 #[test]

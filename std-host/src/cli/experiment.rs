@@ -13,9 +13,11 @@ use crate::experiment::{
 /// Arguments of `rdbvh experiment`.
 #[derive(Args, Debug, Clone)]
 #[command(after_help = "\
-Runs every [[config]] of FILE.toml that has a scene file (found under scene_dir, relative to
-FILE.toml) with every heuristic of [settings].heuristics, in parallel, and writes DIR/results.csv
-(one row per run, the thesis's columns first), DIR/report.md and charts (SVG and PNG).
+Runs every [[config]] of FILE.toml that names a scene file (`file = ...`, found under scene_dir,
+relative to FILE.toml; a config without `file` is skipped with a note, a named file that cannot
+be read is an error) with every heuristic of [settings].heuristics, in parallel, and writes
+DIR/results.csv (one row per run, the thesis's columns first), DIR/report.md and charts (SVG
+and PNG).
 Every [settings] key is optional; rays_per_config and heuristics apply in every mode, the builder
 keys (candidate_planes, max_triangles_per_leaf, inner_node_cost, triangle_cost, thresholds) only
 with --thesis-mode. Charts have text when a TTF font is found (RDBVH_FONT=path, or DejaVu Sans).")]
@@ -96,9 +98,14 @@ pub fn run(args: &ExperimentArgs, out: &mut dyn Write) -> Result<(), CliError> {
     )
     .map_err(w)?;
     let (c, n) = cheaper_groups(&s.ours.structure_over_fallback);
+    let structure = if n == 0 {
+        "no `full` run to compare the structure with the fallback BVH alone".to_string()
+    } else {
+        format!("full structure cheaper than the fallback BVH alone in {c} of {n} groups")
+    };
     writeln!(
         out,
-        "full structure cheaper than the fallback BVH alone in {c} of {n} groups; report: {}",
+        "{structure}; report: {}",
         args.out.join("report.md").display()
     )
     .map_err(w)?;

@@ -62,8 +62,8 @@ pub fn build() -> String {
          sah_cost).\n\
          --json prints one object with the keys scene, triangles (in the build), scene_triangles,\n\
          nodes, leaves, max_depth, sah_cost, pah_cost, bytes, load_ms, select_ms, build_ms,\n\
-         mtris_per_s, builder, preset, thesis_mode, area_kind, bins, max_leaf (null where they do not\n\
-         apply).\n\n\
+         reinsert_ms, reinsert_moved, mtris_per_s, builder, preset, thesis_mode, area_kind, bins,\n\
+         max_leaf (null where they do not apply).\n\n\
          {AREAS}\n\n\
          Examples:\n  \
          rdbvh build scene.obj --preset sah --json\n  \

@@ -269,8 +269,8 @@ fn finish<L: AreaLookup + Sync>(
             per_second(t.fallback_seconds)
         ),
         format!(
-            "structure: `{}` {}{} over {}, {lookup}, up to {} tr{} per ray, {} bytes, built in \
-             {:.3} ms",
+            "structure: `{}` {}{} holding {} (a triangle once per area it overlaps), {lookup}, \
+             up to {} tr{} per ray, {} bytes, built in {:.3} ms",
             options.preset,
             super::count(areas, "local BVH"),
             if options.local.thesis_mode {
@@ -278,7 +278,7 @@ fn finish<L: AreaLookup + Sync>(
             } else {
                 ""
             },
-            super::count(local_triangles as usize, "area triangle"),
+            super::count(local_triangles as usize, "triangle"),
             options.max_tries,
             if options.max_tries == 1 { "y" } else { "ies" },
             structure.memory_bytes(),

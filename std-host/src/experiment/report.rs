@@ -104,13 +104,26 @@ pub fn write_report(
         );
     }
     let (c, n) = cheaper_groups(&ours.structure_over_fallback);
-    let _ = write!(md, "\nThe full structure is cheaper than the fallback BVH alone (all-hit) in {c} of {n} groups");
-    if let Some(x) = th {
-        let (c, n) = cheaper_groups(&x.structure_over_fallback);
-        let _ = write!(md, " (thesis: {c} of {n})");
+    if n == 0 {
+        // Without `full` runs there is no structure to compare ("in 0 of 0 groups").
+        let _ = writeln!(
+            md,
+            "\nNo group ran the full structure (preset `full`): it is not compared with the \
+             fallback BVH alone."
+        );
+    } else {
+        let _ = write!(
+            md,
+            "\nThe full structure is cheaper than the fallback BVH alone (all-hit) in {c} of {n} \
+             groups"
+        );
+        if let Some(x) = th {
+            let (c, n) = cheaper_groups(&x.structure_over_fallback);
+            let _ = write!(md, " (thesis: {c} of {n})");
+        }
+        let (c, n) = cheaper_groups(&ours.structure_over_fallback_closest);
+        let _ = writeln!(md, "; with closest-hit traversal in {c} of {n}.");
     }
-    let (c, n) = cheaper_groups(&ours.structure_over_fallback_closest);
-    let _ = writeln!(md, "; with closest-hit traversal in {c} of {n}.");
 
     let _ = writeln!(
         md,

@@ -217,7 +217,12 @@ fn settings_line(text: &str, key: &str) -> Option<usize> {
     for (i, line) in text.lines().enumerate() {
         let line = line.trim_start();
         if line.starts_with('[') {
-            in_settings = line.trim_end() == "[settings]";
+            // `[settings]`, `[ settings ]`, with or without a trailing comment.
+            let header = line.split('#').next().unwrap_or("").trim();
+            in_settings = header
+                .strip_prefix('[')
+                .and_then(|h| h.strip_suffix(']'))
+                .is_some_and(|h| h.trim() == "settings");
         } else if in_settings {
             let is_key = line
                 .strip_prefix(key)
@@ -340,6 +345,10 @@ mod tests {
             let e = e.to_string();
             assert!(e.starts_with(&format!("e.toml line 3: `{key}` ")), "{e}");
         }
+        // The line is found under a header with a comment too (the thesis's file has one).
+        let bad = format!("[settings]   # the thesis's\n\noctree_levels = 0\n{text}");
+        let e = ExperimentFile::parse(&bad, Path::new("e.toml")).unwrap_err();
+        assert!(e.to_string().starts_with("e.toml line 3: "), "{e}");
         let fine = format!("[settings]\ncandidate_planes = 63\noctree_levels = 10\n{text}");
         assert!(ExperimentFile::parse(&fine, Path::new("e.toml")).is_ok());
         assert!(parse_presets(["full", "bogus"]).is_err());

@@ -7,8 +7,8 @@ use glam::{Vec2, Vec3};
 
 use crate::bvh::Bvh;
 use crate::geometry::{
-    orthographic_silhouette, perspective_silhouette, perspective_window_silhouette, Aabb,
-    ConvexPolygon, Frame, MAX_POLY,
+    clip_convex, orthographic_silhouette, perspective_silhouette, perspective_window_silhouette,
+    Aabb, ConvexPolygon, Frame, MAX_POLY,
 };
 use crate::influence::InfluenceArea;
 
@@ -144,21 +144,7 @@ pub fn convex_intersection_area(a: &ConvexPolygon, b: &ConvexPolygon) -> f32 {
         let (e0, e1) = (pb[i], pb[(i + 1) % pb.len()]);
         let edge = e1 - e0;
         // Inside is to the left of a counter-clockwise edge.
-        let side = |p: Vec2| edge.perp_dot(p - e0);
-        let mut n = 0;
-        for j in 0..len {
-            let (p, q) = (poly[j], poly[(j + 1) % len]);
-            let (sp, sq) = (side(p), side(q));
-            if sp >= 0.0 && n < CAP {
-                next[n] = p;
-                n += 1;
-            }
-            if (sp >= 0.0) != (sq >= 0.0) && n < CAP {
-                let t = sp / (sp - sq);
-                next[n] = p + (q - p) * t;
-                n += 1;
-            }
-        }
+        let n = clip_convex(&poly[..len], &mut next, |p: Vec2| edge.perp_dot(p - e0));
         poly[..n].copy_from_slice(&next[..n]);
         len = n;
         if len < 3 {

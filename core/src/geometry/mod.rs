@@ -19,6 +19,7 @@ pub use convex::{Plane, Polytope};
 pub use frame::Frame;
 pub use frustum::Frustum;
 pub use obb::Obb;
+pub(crate) use polygon::clip_convex;
 pub use polygon::{ConvexPolygon, MAX_POLY};
 pub use projection::{
     box_corner, orthographic_silhouette, perspective_silhouette, perspective_window_silhouette,

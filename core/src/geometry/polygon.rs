@@ -8,6 +8,32 @@ use glam::{Vec2, Vec3};
 /// (8 corners and 6 near-plane cuts), and clipping by a rectangle adds at most 4.
 pub const MAX_POLY: usize = 20;
 
+/// Clips the convex polygon `points` (in order, in the plane or in space) to the half-space
+/// `inside(p) >= 0` (Sutherland-Hodgman), writing at most `out.len()` points into `out`; returns
+/// how many it wrote.
+pub(crate) fn clip_convex<P>(points: &[P], out: &mut [P], inside: impl Fn(P) -> f32) -> usize
+where
+    P: Copy
+        + core::ops::Add<Output = P>
+        + core::ops::Sub<Output = P>
+        + core::ops::Mul<f32, Output = P>,
+{
+    let mut m = 0;
+    for i in 0..points.len() {
+        let (a, c) = (points[i], points[(i + 1) % points.len()]);
+        let (da, dc) = (inside(a), inside(c));
+        if da >= 0.0 && m < out.len() {
+            out[m] = a;
+            m += 1;
+        }
+        if (da >= 0.0) != (dc >= 0.0) && m < out.len() {
+            out[m] = a + (c - a) * (da / (da - dc));
+            m += 1;
+        }
+    }
+    m
+}
+
 /// A convex polygon, counter-clockwise, in a fixed array.
 #[derive(Clone, Copy, Debug)]
 pub struct ConvexPolygon {

@@ -2,7 +2,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{Aabb, ConvexPolygon, Frame, MAX_POLY};
+use super::{clip_convex, Aabb, ConvexPolygon, Frame, MAX_POLY};
 
 /// Corner `i` of a box: the upper bound on x when `i & 1`, on y when `i & 2`, on z when `i & 4`.
 #[inline]
@@ -115,7 +115,9 @@ pub fn perspective_window_silhouette(
             }
             let mut len = 4;
             for plane in planes {
-                len = clip_face(&mut face, len, |p| plane(p, tan, near));
+                let mut clipped = [Vec3::ZERO; FACE_CLIP_MAX];
+                len = clip_convex(&face[..len], &mut clipped, |p| plane(p, tan, near));
+                face = clipped;
                 if len == 0 {
                     break;
                 }
@@ -154,23 +156,3 @@ pub fn perspective_window_silhouette(
 /// The most vertices a box face has while [`perspective_window_silhouette`] clips it: four,
 /// plus one per clipping plane.
 const FACE_CLIP_MAX: usize = 4 + 5;
-
-/// Clips the convex polygon `face[..len]` to `inside(p) >= 0` in place; returns its new length.
-fn clip_face(face: &mut [Vec3; FACE_CLIP_MAX], len: usize, inside: impl Fn(Vec3) -> f32) -> usize {
-    let mut out = [Vec3::ZERO; FACE_CLIP_MAX];
-    let mut m = 0;
-    for i in 0..len {
-        let (a, c) = (face[i], face[(i + 1) % len]);
-        let (da, dc) = (inside(a), inside(c));
-        if da >= 0.0 && m < FACE_CLIP_MAX {
-            out[m] = a;
-            m += 1;
-        }
-        if (da >= 0.0) != (dc >= 0.0) && m < FACE_CLIP_MAX {
-            out[m] = a + (c - a) * (da / (da - dc));
-            m += 1;
-        }
-    }
-    *face = out;
-    m
-}

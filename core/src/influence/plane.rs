@@ -42,7 +42,7 @@ impl PlaneArea {
         let half_width = positive(half_width, "half_width")?;
         let half_height = positive(half_height, "half_height")?;
         let depth = positive(depth, "depth")?;
-        if !(4.0 * half_width * half_height >= MIN_WINDOW_MEASURE) {
+        if 4.0 * half_width * half_height < MIN_WINDOW_MEASURE {
             let key = if half_width < half_height {
                 "half_width"
             } else {

@@ -53,7 +53,7 @@ impl PointArea {
         };
         let tan_x = tan_half(fov_x_deg, "fov_x_deg")?;
         let tan_y = tan_half(fov_y_deg, "fov_y_deg")?;
-        if !(4.0 * tan_x * tan_y >= MIN_WINDOW_MEASURE) {
+        if 4.0 * tan_x * tan_y < MIN_WINDOW_MEASURE {
             let key = if tan_x < tan_y {
                 "fov_x_deg"
             } else {

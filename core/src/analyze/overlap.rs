@@ -7,8 +7,8 @@ use glam::{Vec2, Vec3};
 
 use crate::bvh::Bvh;
 use crate::geometry::{
-    clip_convex, orthographic_silhouette, perspective_silhouette, perspective_window_silhouette,
-    Aabb, ConvexPolygon, Frame, MAX_POLY,
+    clip_convex, orthographic_silhouette, perspective_silhouette, windowed_silhouette, Aabb,
+    ConvexPolygon, Frame, MAX_POLY,
 };
 use crate::influence::InfluenceArea;
 
@@ -116,9 +116,7 @@ impl OverlapSpace {
                 window,
             } => {
                 let project = |x: &Aabb| match window {
-                    Some(t) => {
-                        perspective_window_silhouette(x, eye, &frame, near, t).clip_to_rect(-t, t)
-                    }
+                    Some(t) => windowed_silhouette(x, eye, &frame, near, t),
                     None => perspective_silhouette(x, eye, &frame, near),
                 };
                 let (pa, pb) = (project(a), project(b));

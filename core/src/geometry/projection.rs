@@ -77,6 +77,43 @@ pub fn perspective_silhouette(b: &Aabb, eye: Vec3, frame: &Frame, near: f32) -> 
     ConvexPolygon::hull(&pts[..n])
 }
 
+/// The perspective silhouette of the part of `b` at least `near >= 0` in front of the eye,
+/// clipped to the light's window `[-tan, tan]` on the image plane `z = 1`. Projecting first and
+/// clipping the hull is exact to rounding while the projected points stay within
+/// [`PRECISE_SPAN`] windows of the axis (as they do unless the box comes close to the eye's plane
+/// beside the eye); otherwise the box is clipped in 3D first ([`perspective_window_silhouette`],
+/// several times the work, so only then).
+pub fn windowed_silhouette(
+    b: &Aabb,
+    eye: Vec3,
+    frame: &Frame,
+    near: f32,
+    tan: Vec2,
+) -> ConvexPolygon {
+    // Rays start on the near plane's window rectangle: a box holding all of it (the root's box,
+    // with the light inside) is entered by every ray, and its silhouette is the whole window.
+    let window = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
+    let corner = |(x, y): (f32, f32)| {
+        eye + frame.to_world(Vec3::new(x * tan.x * near, y * tan.y * near, near))
+    };
+    if window.iter().all(|&c| b.contains_point(corner(c))) {
+        return ConvexPolygon::hull(&window.map(|(x, y)| Vec2::new(x * tan.x, y * tan.y)));
+    }
+    let hull = perspective_silhouette(b, eye, frame, near);
+    let span = PRECISE_SPAN * tan.max_element();
+    let precise = hull.points().iter().all(|p| p.abs().max_element() <= span);
+    let hull = if precise {
+        hull
+    } else {
+        perspective_window_silhouette(b, eye, frame, near, tan)
+    };
+    hull.clip_to_rect(-tan, tan)
+}
+
+/// How far from the axis, in windows, projected points may lie for [`windowed_silhouette`] to
+/// clip after projecting: the clip's rounding then stays under about `64 * 2^-24` of the window.
+pub const PRECISE_SPAN: f32 = 4096.0;
+
 /// The perspective silhouette of the part of `b` at least `near >= 0` in front of the eye and
 /// inside the pyramid of half-angle tangents `tan` (the light's window), on the image plane
 /// `z = 1`: the box is clipped in 3D before anything is projected. Each of its six faces is
@@ -93,14 +130,14 @@ pub fn perspective_window_silhouette(
     tan: Vec2,
 ) -> ConvexPolygon {
     let local: [Vec3; 8] = core::array::from_fn(|i| frame.to_local(box_corner(b, i) - eye));
-    // Signed distances to the five planes, positive inside.
-    let planes: [fn(Vec3, Vec2, f32) -> f32; 5] = [
-        |p: Vec3, _: Vec2, near: f32| p.z - near,
-        |p: Vec3, t: Vec2, _: f32| t.x * p.z - p.x,
-        |p: Vec3, t: Vec2, _: f32| t.x * p.z + p.x,
-        |p: Vec3, t: Vec2, _: f32| t.y * p.z - p.y,
-        |p: Vec3, t: Vec2, _: f32| t.y * p.z + p.y,
-    ];
+    // Signed distance to plane `k` of the five, positive inside.
+    let plane = |k: usize, p: Vec3| match k {
+        0 => p.z - near,
+        1 => tan.x * p.z - p.x,
+        2 => tan.x * p.z + p.x,
+        3 => tan.y * p.z - p.y,
+        _ => tan.y * p.z + p.y,
+    };
     // Points gathered for the hull; when they would overflow the hull's input, the hull of those
     // so far (a subset of them) takes their place.
     let mut pts = [Vec2::ZERO; MAX_POLY];
@@ -114,9 +151,9 @@ pub fn perspective_window_silhouette(
                 face[k] = local[side | bits];
             }
             let mut len = 4;
-            for plane in planes {
+            for k in 0..5 {
                 let mut clipped = [Vec3::ZERO; FACE_CLIP_MAX];
-                len = clip_convex(&face[..len], &mut clipped, |p| plane(p, tan, near));
+                len = clip_convex(&face[..len], &mut clipped, |p| plane(k, p));
                 face = clipped;
                 if len == 0 {
                     break;

@@ -6,7 +6,7 @@ use wide::f32x4;
 
 use crate::geometry::{
     box_solid_angle4, box_solid_angle_far4, far_field4, perspective_silhouette,
-    perspective_window_silhouette, Aabb, ConvexPolygon, Frame, FAR_FIELD,
+    windowed_silhouette, Aabb, ConvexPolygon, Frame, FAR_FIELD,
 };
 use crate::influence::PointArea;
 use crate::simd::Aabb4;
@@ -134,10 +134,8 @@ impl PahPerspective {
             return 0.0;
         }
         let poly = if self.cull {
-            // Clipped to the window in 3D, then to the rectangle for the rounding.
             let t = Vec2::new(self.tan_x, self.tan_y);
-            perspective_window_silhouette(b, self.eye, &self.frame, self.near, t)
-                .clip_to_rect(-t, t)
+            windowed_silhouette(b, self.eye, &self.frame, self.near, t)
         } else {
             self.silhouette(b)
         };

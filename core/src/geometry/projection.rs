@@ -111,7 +111,9 @@ pub fn windowed_silhouette(
 }
 
 /// How far from the axis, in windows, projected points may lie for [`windowed_silhouette`] to
-/// clip after projecting: the clip's rounding then stays under about `64 * 2^-24` of the window.
+/// clip after projecting: the clip's rounding is then bounded by about `4096 * 2^-24` (2.4e-4)
+/// of the window, and stays under 1e-5 of the measure in the tests. Boxes past it are rare (they
+/// reach the eye's plane beside the eye), and the 3D clip costs several hull clips.
 pub const PRECISE_SPAN: f32 = 4096.0;
 
 /// The perspective silhouette of the part of `b` at least `near >= 0` in front of the eye and

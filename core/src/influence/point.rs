@@ -196,15 +196,12 @@ mod tests {
         for near in [0.0, 1e-8, 1e-7] {
             let a = PointArea::new(eye, -Vec3::Z, 60.0, 60.0, near, 1.0).unwrap();
             // Origins where the sampler puts them: on the near plane, rounded.
-            let mut inside = 0;
             for i in 0..200 {
                 let (x, y) = ((i % 20) as f32 / 19.0 - 0.5, (i / 20) as f32 / 9.0 - 0.5);
                 let d = Vec3::new(x, y, -1.0);
                 let r = Ray::new(eye + d * near, d).unwrap();
                 assert!(a.is_affine(&r), "near {near}, direction {d}");
-                inside += 1;
             }
-            assert_eq!(inside, 200);
             // Leaving the eye outside the window (or backwards) is not radial to this area.
             for d in [Vec3::new(0.9, 0.0, -1.0), Vec3::Z, Vec3::X] {
                 assert!(!a.is_affine(&Ray::new(eye, d).unwrap()), "{d}");

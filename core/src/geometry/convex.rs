@@ -112,6 +112,17 @@ impl Polytope {
         1e-5 * self.scale.max(other_scale).max(1e-30)
     }
 
+    /// A box holding every point [`Polytope::contains`] accepts: the corners' box grown by the
+    /// containment tolerance (twice over, for the tolerance's own growth with `|p|` and for
+    /// rounding). The corners' box alone can lose a face's points to rounding: an area's light
+    /// face, where its rays start, can round a few ulps outside it.
+    pub fn containment_bounds(&self) -> Aabb {
+        let b = Aabb::from_points(&self.vertices);
+        let scale = self.scale.max(b.min.abs().max(b.max.abs()).max_element());
+        let margin = Vec3::splat(2.0 * self.tolerance(scale));
+        Aabb::new(b.min - margin, b.max + margin)
+    }
+
     /// True when every corner, plane and axis is finite (inputs near `f32::MAX` can overflow).
     pub fn is_finite(&self) -> bool {
         self.vertices.iter().all(|v| v.is_finite())

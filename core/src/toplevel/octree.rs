@@ -60,7 +60,12 @@ impl Octree {
     /// `areas`.
     pub fn build(areas: &[InfluenceArea], max_levels: u32) -> Self {
         let max_levels = max_levels.clamp(1, MAX_OCTREE_LEVELS);
-        let bounds = areas.iter().fold(Aabb::EMPTY, |b, a| b.union(a.bounds()));
+        // Every point an area contains, up to its containment tolerance, must fall inside the
+        // root cell (a plane area's rays start on its light face, which can round outside the
+        // corners' box).
+        let bounds = areas.iter().fold(Aabb::EMPTY, |b, a| {
+            b.union(a.polytope().containment_bounds())
+        });
         let mut tree = Octree {
             bounds,
             nodes: vec![OctNode { first: 0, count: 0 }],
@@ -259,6 +264,34 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn finds_every_area_at_its_own_rays_origins() {
+        // A plane area's rays start on its light face, which rounding can put a few ulps outside
+        // the box of its corners (centre y 0.3, depth 1000: the box's top at 0.29999924): the
+        // root cell must still hold them, or the lookup returns no candidate at all.
+        let mut rng = Pcg32::new(5);
+        let mut checked = 0;
+        for i in 0..300 {
+            let normal = Vec3::new(rng.range(-1.0, 1.0), -1.0, rng.range(-1.0, 1.0));
+            let depth = [1.0, 20.0, 1e3, 1e4][i % 4];
+            let half = rng.range(1e-3, 0.1);
+            let centre = Vec3::new(rng.range(-0.1, 0.1), 0.3, rng.range(-0.1, 0.1));
+            let area: InfluenceArea = PlaneArea::new(centre, normal, half, half, depth)
+                .unwrap()
+                .into();
+            let tree = Octree::build(&[area], 5);
+            let mut sampler = crate::influence::RaySampler::new(area, i as u64);
+            for _ in 0..50 {
+                let ray = sampler.sample();
+                if area.contains(ray.origin) {
+                    assert_eq!(tree.candidates(ray.origin), &[0], "area {i}: {area:?}");
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 10_000, "{checked}");
     }
 
     #[test]

@@ -463,12 +463,32 @@ impl BuildArena {
     }
 
     /// Clears the arena and loads the triangles whose ids `ids` yields (a local BVH's subset).
+    /// On an error the arena is left empty, as after [`BuildArena::clear`], never with the
+    /// triangles before the bad one.
+    ///
+    /// Each id should appear once: a repeated id loads its triangle twice, and the tree then
+    /// holds it in two leaves (queries still answer right, and [`crate::bvh::Bvh::validate`]
+    /// reports `PrimitiveCount`). The check would need a set as large as `tris`, which the arena
+    /// does not keep.
     pub fn load_triangle_subset<I>(&mut self, tris: &[Triangle], ids: I) -> Result<(), BuildError>
     where
         I: IntoIterator,
         I::Item: TryInto<u32>,
     {
         self.clear();
+        let loaded = self.push_subset(tris, ids);
+        if loaded.is_err() {
+            self.clear();
+        }
+        loaded
+    }
+
+    /// [`BuildArena::load_triangle_subset`]'s loop, stopping at the first error.
+    fn push_subset<I>(&mut self, tris: &[Triangle], ids: I) -> Result<(), BuildError>
+    where
+        I: IntoIterator,
+        I::Item: TryInto<u32>,
+    {
         if tris.len() > u32::MAX as usize {
             return Err(BuildError::TooManyPrimitives);
         }
@@ -614,6 +634,39 @@ pub(crate) fn lanes_to_aabb(lo: f32x4, hi: f32x4) -> Aabb {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A load that fails leaves the arena empty: a later build must not quietly run over the
+    /// triangles loaded before the error.
+    #[test]
+    fn a_failed_load_leaves_the_arena_empty() {
+        let t = |x: f32| {
+            Triangle::new(
+                Vec3::new(x, 0.0, 0.0),
+                Vec3::new(x + 1.0, 0.0, 0.0),
+                Vec3::new(x, 1.0, 0.0),
+            )
+        };
+        let mut bad = [t(0.0), t(2.0), t(4.0)];
+        let mut arena = BuildArena::with_capacity(2);
+        assert!(matches!(
+            arena.load_triangles(&bad),
+            Err(BuildError::ArenaFull { .. })
+        ));
+        assert!(arena.is_empty());
+        bad[1].v1.x = f32::NAN;
+        let mut arena = BuildArena::with_capacity(3);
+        assert_eq!(
+            arena.load_triangles(&bad),
+            Err(BuildError::InvalidPrimitive { index: 1 })
+        );
+        assert!(arena.is_empty());
+        assert!(arena.load_triangle_subset(&bad, [0u32, 1]).is_err());
+        assert!(arena.is_empty());
+        assert!(arena.load_triangle_subset(&bad, [0u32, 7]).is_err());
+        assert!(arena.is_empty() && arena.bounds.is_empty());
+        arena.load_triangle_subset(&bad, [2u32, 0]).unwrap();
+        assert_eq!(arena.len(), 2);
+    }
 
     /// Every id comes back, and lane 3 of both corners and of the centroid is a normal float
     /// (no subnormal for the 4-wide arithmetic to trip on).

@@ -93,6 +93,9 @@ pub struct ReinsertStats {
     /// True when the optimized tree would have been deeper than [`ReinsertConfig::max_depth`], so
     /// the input tree was kept unchanged.
     pub kept_for_depth: bool,
+    /// True when the settings were not [valid](ReinsertConfig::is_valid), so nothing ran and the
+    /// tree is unchanged.
+    pub invalid_config: bool,
 }
 
 /// A float's bits, mapped so that unsigned order is [`f32::total_cmp`]'s order.
@@ -151,7 +154,8 @@ impl Reinserter {
     /// `config.fraction` largest nodes. The result holds the same leaves (primitives and boxes), is
     /// laid out as a builder lays it out (depth first, children adjacent, primitive runs in leaf
     /// order), and costs no more than the input under `model`. A tree of fewer than five nodes,
-    /// a root of zero or non-finite measure, or an invalid `config` leave `bvh` as it was.
+    /// a root of zero or non-finite measure, or an invalid `config` leave `bvh` as it was (the
+    /// last says so in [`ReinsertStats::invalid_config`]).
     ///
     /// Nodes the model measures at zero (a PAH node outside the light's window) are not tried:
     /// every place costs them nothing, so they stay where the build put them.
@@ -161,8 +165,11 @@ impl Reinserter {
         model: &M,
         config: &ReinsertConfig,
     ) -> ReinsertStats {
-        let mut stats = ReinsertStats::default();
-        if bvh.nodes.len() < 5 || !config.is_valid() {
+        let mut stats = ReinsertStats {
+            invalid_config: !config.is_valid(),
+            ..ReinsertStats::default()
+        };
+        if bvh.nodes.len() < 5 || stats.invalid_config {
             return stats;
         }
         self.load(bvh, model);
@@ -562,7 +569,11 @@ mod tests {
             let stats = reinsert(&mut bvh, &Sah, &config);
             assert_eq!(bvh, built, "{config:?}");
             assert_eq!(stats.moved, 0);
+            // Zero passes is a valid request for nothing; the rest are refused, and say so.
+            assert_eq!(stats.invalid_config, config.max_passes != 0, "{config:?}");
         }
+        let mut bvh = built.clone();
+        assert!(!reinsert(&mut bvh, &Sah, &ReinsertConfig::default()).invalid_config);
         for n in [0, 1, 2] {
             let tris = &tris[..n];
             let built = Builder::sah().build(tris).unwrap();

@@ -183,7 +183,7 @@ pub fn build_scene<L: AreaLookup>(
             area: i as u32,
             error,
         };
-        let ids: Vec<u32> = Scene::<L>::triangles_in_area(area, tris).collect();
+        let ids: Vec<u32> = area.triangles_in(tris).collect();
         let mut arena = BuildArena::with_capacity(ids.len());
         arena
             .load_triangle_subset(tris, ids)

@@ -11,7 +11,6 @@ use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::heuristics::{PerspectiveMeasure, Sah};
 use rdbvh_core::influence::{InfluenceArea, PointArea, PointDistribution, RaySampler};
-use rdbvh_core::toplevel::Scene as Structure;
 use rdbvh_tests::require_shared;
 
 /// Rays per configuration, as the issue asks.
@@ -21,10 +20,7 @@ const RAYS: u32 = 100_000;
 fn local_bvh(tris: &[Triangle], area: &InfluenceArea, preset: Preset, o: &PresetOptions) -> Bvh {
     let mut arena = BuildArena::with_capacity(tris.len());
     arena
-        .load_triangle_subset(
-            tris,
-            Structure::<rdbvh_core::toplevel::AreaList>::triangles_in_area(area, tris),
-        )
+        .load_triangle_subset(tris, area.triangles_in(tris))
         .unwrap();
     let mut bvh = Bvh::with_capacity(arena.len());
     preset

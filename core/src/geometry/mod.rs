@@ -23,7 +23,7 @@ pub(crate) use polygon::clip_convex;
 pub use polygon::{ConvexPolygon, MAX_POLY};
 pub use projection::{
     box_corner, orthographic_silhouette, perspective_silhouette, perspective_window_silhouette,
-    windowed_silhouette,
+    windowed_silhouette, MIN_RELATIVE_DEPTH, PRECISE_SPAN,
 };
 pub use ray::{Ray, RayError};
 pub use solid_angle::{box_solid_angle4, box_solid_angle_far4, far_field4, FAR_FIELD};

@@ -60,6 +60,28 @@ impl InfluenceArea {
         self.polytope().clip_ray(ray).map(|(_, t1)| t1)
     }
 
+    /// The ids of the triangles of `tris` this area's local BVH holds ([`crate::toplevel::Scene`]
+    /// builds it over them): those [`InfluenceArea::takes_triangle`] takes, in id order.
+    pub fn triangles_in<'a>(&'a self, tris: &'a [Triangle]) -> impl Iterator<Item = u32> + 'a {
+        let bounds = self.bounds().padded();
+        (0..tris.len() as u32).filter(move |&t| self.takes_triangle(&bounds, &tris[t as usize]))
+    }
+
+    /// Whether this area (whose `self.bounds().padded()` is `bounds`) takes triangle `tri` into
+    /// its local BVH: a cheap box test first, then the separating-axis test. The box test uses
+    /// the padded boxes the BVH nodes use, so it never rejects a triangle whose hits a BVH
+    /// reports; the separating-axis test is conservative by a relative 1e-5 of the larger
+    /// coordinate magnitude of the area's corners and the triangle's
+    /// ([`crate::geometry::Polytope::overlaps_triangle`]), so it never drops a triangle the area
+    /// touches, and for a very large area (a 179-degree frustum reaching 1e5 units has corners
+    /// near 1e7) it also takes triangles within that margin of it: more work, never a different
+    /// answer. Every command and the experiment runner select an area's triangles by this one
+    /// test.
+    #[inline]
+    pub fn takes_triangle(&self, bounds: &Aabb, tri: &Triangle) -> bool {
+        !tri.bounds().padded().intersection(*bounds).is_empty() && self.overlaps_triangle(tri)
+    }
+
     /// The affinity test of the area's kind.
     pub fn is_affine(&self, ray: &Ray) -> bool {
         match self {

@@ -6,7 +6,7 @@ use core::fmt;
 use super::{AreaList, AreaLookup, BreakEven, Octree};
 use crate::build::{BuildArena, Preset, PresetError, PresetOptions, ReinsertConfig};
 use crate::bvh::{Bvh, Hit, Traversable, TraversalStats, WideBvh};
-use crate::geometry::{Aabb, Ray, Triangle};
+use crate::geometry::{Ray, Triangle};
 use crate::heuristics::CostConstants;
 use crate::influence::InfluenceArea;
 
@@ -117,7 +117,7 @@ impl SceneStats {
 /// traverses each one's local BVH over the part of the segment inside the area, `[t_min, t_exit]`.
 /// A local hit is accepted only there (a closer triangle just outside the area cannot exist: the
 /// segment up to `t_exit` lies inside the area, and every triangle meeting the area is in its
-/// local BVH by the conservative separating-axis test of [`Scene::area_takes`]). Otherwise the
+/// local BVH by the conservative separating-axis test of [`InfluenceArea::takes_triangle`]). Otherwise the
 /// fallback BVH answers the rest of the segment. Every answer equals the brute-force one.
 ///
 /// The trees `T` are binary [`Bvh`]s as built; [`Scene::widen`] turns every one into a
@@ -170,7 +170,7 @@ impl<L: AreaLookup> Scene<L> {
                 error,
             };
             arena
-                .load_triangle_subset(tris, Self::triangles_in_area(area, tris))
+                .load_triangle_subset(tris, area.triangles_in(tris))
                 .map_err(|e| fail(e.into()))?;
             let mut bvh = Bvh::with_capacity(arena.len());
             options
@@ -236,31 +236,6 @@ impl<L: AreaLookup, T: Traversable> Scene<L, T> {
             lookup,
             max_tries,
         })
-    }
-
-    /// The triangle ids that [`Scene::build`] gives area `area`'s local BVH: those
-    /// [`Scene::area_takes`] takes, in id order.
-    pub fn triangles_in_area<'a>(
-        area: &'a InfluenceArea,
-        tris: &'a [Triangle],
-    ) -> impl Iterator<Item = u32> + 'a {
-        let bounds = area.bounds().padded();
-        (0..tris.len() as u32).filter(move |&t| Self::area_takes(area, &bounds, &tris[t as usize]))
-    }
-
-    /// Whether area `area` (whose `area.bounds().padded()` is `bounds`) takes triangle `tri`
-    /// into its local BVH: a cheap box test first, then the separating-axis test. The box test
-    /// uses the padded boxes the BVH nodes use, so it never rejects a triangle whose hits a BVH
-    /// reports; the separating-axis test is conservative by a relative 1e-5 of the larger
-    /// coordinate magnitude of the area's corners and the triangle's
-    /// ([`crate::geometry::Polytope::overlaps_triangle`]), so it never drops a triangle the area
-    /// touches, and for a very large area (a 179-degree frustum reaching 1e5 units has corners
-    /// near 1e7) it also takes triangles within that margin of it: more work, never a different
-    /// answer. Every command and the experiment runner select an area's triangles by this one
-    /// test.
-    #[inline]
-    pub fn area_takes(area: &InfluenceArea, bounds: &Aabb, tri: &Triangle) -> bool {
-        !tri.bounds().padded().intersection(*bounds).is_empty() && area.overlaps_triangle(tri)
     }
 
     /// The influence areas.
@@ -389,14 +364,18 @@ impl<L: AreaLookup, T: Traversable> Scene<L, T> {
     }
 
     /// The break-even measurement for area `area` over `rays`: its local hit rate, the local and
-    /// fallback closest-hit costs, and the cost through the structure.
+    /// fallback closest-hit costs, and the cost through the structure. `None` when the scene has
+    /// no area `area`.
     pub fn break_even(
         &self,
         area: usize,
         rays: impl IntoIterator<Item = Ray>,
         tris: &[Triangle],
         k: CostConstants,
-    ) -> BreakEven {
+    ) -> Option<BreakEven> {
+        if area >= self.areas.len() {
+            return None;
+        }
         let mut out = BreakEven::default();
         let (mut hits, mut local, mut global, mut structure) = (0u32, 0f64, 0f64, 0f64);
         for ray in rays {
@@ -419,7 +398,7 @@ impl<L: AreaLookup, T: Traversable> Scene<L, T> {
             out.cost_global = (global / n) as f32;
             out.cost_structure = (structure / n) as f32;
         }
-        out
+        Some(out)
     }
 
     /// Keeps only the areas `keep` accepts (by index), rebuilding the lookup: for dropping the
@@ -559,7 +538,9 @@ mod tests {
         let tris = soup(800, 3);
         let mut scene = Scene::with_octree(&tris, areas(), &SceneOptions::default(), 5).unwrap();
         let rays: Vec<Ray> = RaySampler::new(scene.areas()[0], 1).take(2000).collect();
-        let be = scene.break_even(0, rays, &tris, CostConstants::default());
+        let k = CostConstants::default();
+        assert_eq!(scene.break_even(2, rays.iter().copied(), &tris, k), None);
+        let be = scene.break_even(0, rays, &tris, k).unwrap();
         assert_eq!(be.rays, 2000);
         assert!(be.cost_global > 0.0 && be.cost_local > 0.0);
         assert!((0.0..=1.0).contains(&be.hit_rate));

@@ -351,11 +351,7 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
         if i == 0 {
             if let Some(path) = &args.nodes {
                 // The same build again, for its per-node records.
-                let ids: Vec<u32> = rdbvh_core::toplevel::Scene::<Octree>::triangles_in_area(
-                    &entry.area,
-                    &scene.triangles,
-                )
-                .collect();
+                let ids: Vec<u32> = entry.area.triangles_in(&scene.triangles).collect();
                 let mut arena = rdbvh_core::build::BuildArena::with_capacity(ids.len());
                 arena.load_triangle_subset(&scene.triangles, ids)?;
                 let mut bvh = rdbvh_core::bvh::Bvh::with_capacity(arena.len());

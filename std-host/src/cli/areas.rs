@@ -6,7 +6,6 @@ use std::path::Path;
 use rayon::prelude::*;
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::influence::InfluenceArea;
-use rdbvh_core::toplevel::{Octree, Scene as Structure};
 
 use super::CliError;
 use crate::areas::{read_areas, AreaEntry};
@@ -21,14 +20,14 @@ pub fn load_areas(path: &Path, scene: &Scene) -> Result<Vec<AreaEntry>, CliError
 }
 
 /// Ids of the triangles that `area` takes into its local BVH, in id order: the scene
-/// structure's own test ([`Structure::area_takes`]: a separating-axis test, so a triangle that crosses
+/// structure's own test ([`InfluenceArea::takes_triangle`]: a separating-axis test, so a triangle that crosses
 /// the area with no vertex inside it is included), on all threads, so `build`, `analyze`,
 /// `trace` and `experiment` report the same triangles for the same area.
 pub fn overlapping(triangles: &[Triangle], area: &InfluenceArea) -> Vec<u32> {
     let bounds = area.bounds().padded();
     (0..triangles.len() as u32)
         .into_par_iter()
-        .filter(|&i| Structure::<Octree>::area_takes(area, &bounds, &triangles[i as usize]))
+        .filter(|&i| area.takes_triangle(&bounds, &triangles[i as usize]))
         .collect()
 }
 
@@ -88,7 +87,7 @@ mod tests {
                 Triangle::new(a, a + Vec3::X, a + Vec3::Z)
             })
             .collect();
-        let structure: Vec<u32> = Structure::<Octree>::triangles_in_area(&area, &tris).collect();
+        let structure: Vec<u32> = area.triangles_in(&tris).collect();
         assert_eq!(overlapping(&tris, &area), structure);
         // The test is conservative: everything the area touches is taken (these triangles lie
         // in planes y = const, so y >= 5 means inside the upward frustum's half-space).

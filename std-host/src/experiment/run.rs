@@ -109,7 +109,7 @@ pub fn run_one(
     setup: &RunSetup,
 ) -> Result<RunMetrics, ExperimentError> {
     let k = setup.constants;
-    let ids: Vec<u32> = Scene::<Octree>::triangles_in_area(area, tris).collect();
+    let ids: Vec<u32> = area.triangles_in(tris).collect();
     let mut arena = BuildArena::with_capacity(ids.len());
     let mut local = Bvh::with_capacity(ids.len());
     let start = Instant::now();

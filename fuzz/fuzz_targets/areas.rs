@@ -7,7 +7,7 @@ use arbitrary::{Result, Unstructured};
 use libfuzzer_sys::fuzz_target;
 use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 use rdbvh_core::influence::{
-    AreaError, InfluenceArea, PlaneArea, PointArea, PointDistribution, RaySampler,
+    AreaError, InfluenceArea, PlaneArea, PointArea, PointDistribution, RaySampler, MIN_WINDOW_MEASURE,
 };
 use rdbvh_core::Vec3;
 use rdbvh_fuzz::*;
@@ -41,6 +41,8 @@ fn run(u: &mut Unstructured) -> Result<()> {
                     .then_some("NotFinite"),
                 zero_dir(dir).then_some("ZeroDirection"),
                 lengths.iter().any(|&x| x <= 0.0).then_some("NotPositive"),
+                (hw > 0.0 && hh > 0.0 && 4.0 * hw * hh < MIN_WINDOW_MEASURE)
+                    .then_some("TooSmall"),
             ],
         );
         match made {
@@ -206,7 +208,8 @@ fn check_error(err: Option<&AreaError>, reasons: &[Option<&'static str>]) {
     let reasons: Vec<&str> = reasons.iter().flatten().copied().collect();
     if reasons.is_empty() {
         // Beyond the documented bad values, only derived geometry that overflows (coordinates
-        // near `f32::MAX`), an area reaching beyond 1e18 or a frustum too thin to have planes
+        // near `f32::MAX`), an area reaching beyond 1e18, a frustum too thin to have planes or
+        // a window too small to measure (fields of view whose tangents' product underflows)
         // may be rejected.
         if let Some(e) = err {
             assert!(
@@ -216,6 +219,7 @@ fn check_error(err: Option<&AreaError>, reasons: &[Option<&'static str>]) {
                         | AreaError::FieldOfView(_)
                         | AreaError::NearFar
                         | AreaError::TooLarge(_)
+                        | AreaError::TooSmall(_)
                 ),
                 "{e:?} with no documented reason"
             );

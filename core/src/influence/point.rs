@@ -53,14 +53,6 @@ impl PointArea {
         };
         let tan_x = tan_half(fov_x_deg, "fov_x_deg")?;
         let tan_y = tan_half(fov_y_deg, "fov_y_deg")?;
-        if 4.0 * tan_x * tan_y < MIN_WINDOW_MEASURE {
-            let key = if tan_x < tan_y {
-                "fov_x_deg"
-            } else {
-                "fov_y_deg"
-            };
-            return Err(AreaError::TooSmall(key));
-        }
         if !near.is_finite() {
             return Err(AreaError::NotFinite("near"));
         }
@@ -69,6 +61,15 @@ impl PointArea {
         }
         let frustum =
             Frustum::new(eye, frame, tan_x, tan_y, near, far).ok_or(AreaError::NearFar)?;
+        // After every check of a value alone: a window too small to measure is derived from two.
+        if 4.0 * tan_x * tan_y < MIN_WINDOW_MEASURE {
+            let key = if tan_x < tan_y {
+                "fov_x_deg"
+            } else {
+                "fov_y_deg"
+            };
+            return Err(AreaError::TooSmall(key));
+        }
         let polytope = frustum.polytope();
         if !polytope.is_finite() {
             // Finite inputs near f32::MAX can still overflow the frustum's corners and planes.

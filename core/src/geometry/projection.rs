@@ -141,7 +141,9 @@ pub fn perspective_window_silhouette(
         _ => tan.y * p.z + p.y,
     };
     // Points gathered for the hull; when they would overflow the hull's input, the hull of those
-    // so far (a subset of them) takes their place.
+    // so far (a subset of them) takes their place. Two points closer than a millionth of the
+    // window (every point lies inside it) are one vertex reached from two faces.
+    let same = 1e-6 * tan.max_element();
     let mut pts = [Vec2::ZERO; MAX_POLY];
     let mut n = 0;
     for (axis, other) in [(1usize, [2usize, 4]), (2, [4, 1]), (4, [1, 2])] {
@@ -171,7 +173,7 @@ pub fn perspective_window_silhouette(
                 // A vertex of the solid is on three faces: keep it once.
                 if pts[..n]
                     .iter()
-                    .any(|&r| (q - r).abs().max_element() <= 1e-6)
+                    .any(|&r| (q - r).abs().max_element() <= same)
                 {
                     continue;
                 }

@@ -31,6 +31,18 @@ pub enum AreaError {
 /// subnormals and zero, and every PAH cost over the window reads zero.
 pub const MIN_WINDOW_MEASURE: f32 = 1.0 / (1u128 << 100) as f32;
 
+/// [`AreaError::TooSmall`] (naming the smaller side's key) unless a window of half sides `a`
+/// and `b` (half extents, or half-angle tangents) measures at least [`MIN_WINDOW_MEASURE`].
+pub(crate) fn window_measurable(
+    (a, a_key): (f32, &'static str),
+    (b, b_key): (f32, &'static str),
+) -> Result<(), AreaError> {
+    if 4.0 * a * b >= MIN_WINDOW_MEASURE {
+        return Ok(());
+    }
+    Err(AreaError::TooSmall(if a < b { a_key } else { b_key }))
+}
+
 /// How far from the origin an influence area may reach, per coordinate. Its plane offsets and
 /// separating-axis projections multiply coordinates, and `1e18` squared stays well inside `f32`.
 pub const MAX_AREA_COORDINATE: f32 = 1e18;

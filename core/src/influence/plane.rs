@@ -2,8 +2,8 @@
 
 use glam::Vec3;
 
-use super::error::{cos_tolerance, finite3, positive};
-use super::{AreaError, DEFAULT_AFFINITY_DEG, MAX_AREA_COORDINATE, MIN_WINDOW_MEASURE};
+use super::error::{cos_tolerance, finite3, positive, window_measurable};
+use super::{AreaError, DEFAULT_AFFINITY_DEG, MAX_AREA_COORDINATE};
 use crate::geometry::{Aabb, Frame, Obb, Polytope, Ray, Triangle};
 
 /// An oriented box: the light rectangle (centre `center`, half extents `half_width` along
@@ -42,14 +42,7 @@ impl PlaneArea {
         let half_width = positive(half_width, "half_width")?;
         let half_height = positive(half_height, "half_height")?;
         let depth = positive(depth, "depth")?;
-        if 4.0 * half_width * half_height < MIN_WINDOW_MEASURE {
-            let key = if half_width < half_height {
-                "half_width"
-            } else {
-                "half_height"
-            };
-            return Err(AreaError::TooSmall(key));
-        }
+        window_measurable((half_width, "half_width"), (half_height, "half_height"))?;
         let obb = Obb::new(
             center + frame.forward * (0.5 * depth),
             frame,

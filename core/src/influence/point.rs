@@ -2,8 +2,8 @@
 
 use glam::Vec3;
 
-use super::error::{cos_tolerance, finite3};
-use super::{AreaError, DEFAULT_AFFINITY_DEG, MAX_AREA_COORDINATE, MIN_WINDOW_MEASURE};
+use super::error::{cos_tolerance, finite3, window_measurable};
+use super::{AreaError, DEFAULT_AFFINITY_DEG, MAX_AREA_COORDINATE};
 use crate::geometry::{Aabb, Frame, Frustum, Polytope, Ray, Triangle};
 
 /// How close to the eye, relative to the coordinates' magnitude, an origin counts as the eye
@@ -62,14 +62,7 @@ impl PointArea {
         let frustum =
             Frustum::new(eye, frame, tan_x, tan_y, near, far).ok_or(AreaError::NearFar)?;
         // After every check of a value alone: a window too small to measure is derived from two.
-        if 4.0 * tan_x * tan_y < MIN_WINDOW_MEASURE {
-            let key = if tan_x < tan_y {
-                "fov_x_deg"
-            } else {
-                "fov_y_deg"
-            };
-            return Err(AreaError::TooSmall(key));
-        }
+        window_measurable((tan_x, "fov_x_deg"), (tan_y, "fov_y_deg"))?;
         let polytope = frustum.polytope();
         if !polytope.is_finite() {
             // Finite inputs near f32::MAX can still overflow the frustum's corners and planes.

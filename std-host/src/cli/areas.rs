@@ -20,9 +20,10 @@ pub fn load_areas(path: &Path, scene: &Scene) -> Result<Vec<AreaEntry>, CliError
 }
 
 /// Ids of the triangles that `area` takes into its local BVH, in id order: the scene
-/// structure's own test ([`InfluenceArea::takes_triangle`]: a separating-axis test, so a triangle that crosses
-/// the area with no vertex inside it is included), on all threads, so `build`, `analyze`,
-/// `trace` and `experiment` report the same triangles for the same area.
+/// structure's own test ([`InfluenceArea::takes_triangle`]: a separating-axis test, so a
+/// triangle that crosses the area with no vertex inside it is included), as
+/// [`InfluenceArea::triangles_in`] but on all threads, so `build`, `analyze`, `trace` and
+/// `experiment` report the same triangles for the same area.
 pub fn overlapping(triangles: &[Triangle], area: &InfluenceArea) -> Vec<u32> {
     let bounds = area.bounds().padded();
     (0..triangles.len() as u32)

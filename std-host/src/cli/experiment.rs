@@ -50,7 +50,8 @@ pub struct ExperimentArgs {
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub max_leaf: Option<u32>,
     /// Octree levels, 1 to 10 (overrides octree_levels).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32)
+        .range(1..=i64::from(rdbvh_core::toplevel::MAX_OCTREE_LEVELS)))]
     pub octree_levels: Option<u32>,
 }
 

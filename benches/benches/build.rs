@@ -3,8 +3,9 @@
 //! rayon pool, so obvhs's `parallel` feature cannot spread it; clock per `RDBVH_BENCH_CLOCK`),
 //! `build_mt/SCENE/LIB` the threaded build on every core, always in wall time (its work is on
 //! several threads), `build_pah/SCENE/...` rdbvh's SAH preset beside PAH + SPFH (`full`) with
-//! a plane and a point area over the scene, and `reinsert/SCENE` the reinsertion pass alone. These
-//! are the rows of the `peers` binary's table.
+//! a plane and a point area over the scene, `reinsert/SCENE` the reinsertion pass alone (these
+//! are the rows of the `peers` binary's table), and `wide/SCENE/...` the SAH build and its 4-wide
+//! collapse beside `Builder::for_wide`'s build and the same collapse.
 //!
 //! Each library builds from triangles already in its own format (converted once, untimed); the
 //! timed build includes bounding the triangles, which every builder must do. Outputs are dropped
@@ -23,8 +24,8 @@ use criterion::{
 use rdbvh_benches::compare::{plane_area_over, point_area_over};
 use rdbvh_benches::peers::{BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Rdbvh, RdbvhWide};
 use rdbvh_benches::{bounds, load_scene, single_thread_pool, RdbvhReuse, BENCH_SCENES};
-use rdbvh_core::build::{BuildArena, Preset, PresetOptions, ReinsertConfig, Reinserter};
-use rdbvh_core::bvh::Bvh;
+use rdbvh_core::build::{BuildArena, Builder, Preset, PresetOptions, ReinsertConfig, Reinserter};
+use rdbvh_core::bvh::{Bvh, WideBvh};
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::heuristics::Sah;
 use rdbvh_core::influence::InfluenceArea;
@@ -148,6 +149,26 @@ fn builds(c: &mut Criterion<Clock>) {
                 BatchSize::LargeInput,
             )
         });
+        group.finish();
+
+        // A 4-wide tree without reinsertion: the SAH build and its collapse, beside the build
+        // that leaves the nodes of at most four triangles unsplit (the same wide nodes).
+        let mut group = c.benchmark_group(format!("wide/{name}"));
+        configure(&mut group, tris.len());
+        for (id, for_wide) in [("sah-collapse", false), ("for_wide-collapse", true)] {
+            group.bench_function(id, |bench| {
+                bench.iter(|| {
+                    let bvh = if for_wide {
+                        Builder::sah().for_wide().build(black_box(&tris))
+                    } else {
+                        Builder::sah().build(black_box(&tris))
+                    };
+                    WideBvh::from_binary(&bvh.expect("finite triangles"), &tris)
+                        .nodes()
+                        .len()
+                })
+            });
+        }
         group.finish();
     }
 }

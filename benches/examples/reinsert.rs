@@ -1,8 +1,10 @@
 //! What reinsertion buys on one scene: `cargo run --release -p rdbvh-benches --example reinsert --
-//! SCENE [FRACTION PASSES]...`. Builds the binned SAH tree, then for each `(fraction, passes)`
-//! pair (default: a small sweep) optimizes a copy and prints its time (thread CPU) and SAH cost,
-//! then the 4-wide collapse's traversal cost over eleven views, then its closest-hit speed on the
-//! `peers` camera and random rays (interleaved rounds, best of 5, every answer checked).
+//! SCENE [--for-wide] [FRACTION PASSES]...`. Builds the binned SAH tree, then for each `(fraction,
+//! passes)` pair (default: a small sweep) optimizes a copy and prints its time (thread CPU) and SAH
+//! cost, then the 4-wide collapse's traversal cost over eleven views, then its closest-hit speed on
+//! the `peers` camera and random rays (interleaved rounds, best of 5, every answer checked).
+//! `--for-wide` adds the same for the tree of `Builder::sah().for_wide()` (nodes of at most four
+//! triangles left unsplit), whose reinsertion moves four-triangle leaves as units.
 //!
 //! The views: six pinhole cameras outside the scene's box from different sides, four inside it
 //! looking across, and uniform random rays. A view's cost is the 4-wide traversal's inner nodes
@@ -83,7 +85,7 @@ fn trace(wide: &WideBvh, rays: &[Ray]) -> (f64, Vec<Option<f32>>) {
     (rays.len() as f64 / s / 1e6, hits)
 }
 
-fn run(scene: &str, configs: &[(f32, u32)]) -> Result<(), String> {
+fn run(scene: &str, for_wide: bool, configs: &[(f32, u32)]) -> Result<(), String> {
     let tris: Vec<Triangle> = load_scene(scene)?;
     let base = Builder::sah().build(&tris).map_err(|e| e.to_string())?;
     let k = CostConstants::default();
@@ -98,7 +100,24 @@ fn run(scene: &str, configs: &[(f32, u32)]) -> Result<(), String> {
     );
     let mut trees: Vec<(String, Bvh)> = vec![("build".to_string(), base.clone())];
     let mut reinserter = Reinserter::new();
-    for &(fraction, passes) in configs {
+    let mut runs = vec![(String::new(), base.clone())];
+    if for_wide {
+        let pruned = Builder::sah()
+            .for_wide()
+            .build(&tris)
+            .map_err(|e| e.to_string())?;
+        println!(
+            "  for_wide build: {} nodes (the build's {})",
+            pruned.nodes().len(),
+            base.nodes().len()
+        );
+        trees.push(("for_wide".to_string(), pruned.clone()));
+        runs.push(("for_wide ".to_string(), pruned));
+    }
+    for ((prefix, base), &(fraction, passes)) in runs
+        .iter()
+        .flat_map(|run| configs.iter().map(move |c| (run, c)))
+    {
         let config = ReinsertConfig {
             fraction,
             max_passes: passes,
@@ -116,12 +135,12 @@ fn run(scene: &str, configs: &[(f32, u32)]) -> Result<(), String> {
         tree.validate(tris.len(), |i| tris[i as usize].bounds())
             .map_err(|e| format!("reinserted tree invalid: {e}"))?;
         println!(
-            "  {fraction}/{passes}: {best_ms:.1} ms ({:.2}x the build), sah_cost {:.4}, depth {}, {stats:?}",
+            "  {prefix}{fraction}/{passes}: {best_ms:.1} ms ({:.2}x the build), sah_cost {:.4}, depth {}, {stats:?}",
             best_ms / build_ms,
             tree.estimated_cost(&Sah, k),
             tree.max_depth()
         );
-        trees.push((format!("{fraction}/{passes}"), tree));
+        trees.push((format!("{prefix}{fraction}/{passes}"), tree));
     }
     let wides: Vec<WideBvh> = trees
         .iter()
@@ -172,11 +191,13 @@ fn run(scene: &str, configs: &[(f32, u32)]) -> Result<(), String> {
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let Some(scene) = args.first() else {
-        eprintln!("error: usage: reinsert SCENE [FRACTION PASSES]...");
+        eprintln!("error: usage: reinsert SCENE [--for-wide] [FRACTION PASSES]...");
         return ExitCode::FAILURE;
     };
+    let for_wide = args.iter().any(|a| a == "--for-wide");
+    let rest: Vec<&String> = args[1..].iter().filter(|a| *a != "--for-wide").collect();
     let mut configs = Vec::new();
-    for pair in args[1..].chunks(2) {
+    for pair in rest.chunks(2) {
         match (
             pair[0].parse::<f32>(),
             pair.get(1).map(|p| p.parse::<u32>()),
@@ -191,7 +212,7 @@ fn main() -> ExitCode {
     if configs.is_empty() {
         configs = vec![(0.01, 1), (0.01, 2), (0.02, 2), (0.02, 3), (0.05, 3)];
     }
-    match run(scene, &configs) {
+    match run(scene, for_wide, &configs) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");

@@ -1,5 +1,6 @@
 //! Build with every preset and both builders over arbitrary triangles, and reinsert each tree,
-//! then check the tree invariants and every traversal (binary and 4-wide) against brute force.
+//! then check the tree invariants and every traversal (binary and 4-wide) against brute force;
+//! both builders' trees built `for_wide` must collapse to the same 4-wide nodes.
 #![no_main]
 
 use arbitrary::{Result, Unstructured};
@@ -33,13 +34,29 @@ fn run(u: &mut Unstructured) -> Result<()> {
     let mut built: Vec<(String, Bvh, u32)> = Vec::new();
     for round in 0..2 {
         let config = build_config(u)?;
-        let (name, result) = if round == 0 {
-            ("sah", Builder::sah().with_config(config).build(&tris))
+        // With the tree built for the 4-wide collapse alone, which must collapse alike.
+        let (name, result, for_wide) = if round == 0 {
+            let b = Builder::sah().with_config(config);
+            ("sah", b.build(&tris), b.for_wide().build(&tris))
         } else {
-            ("lsph", Builder::lsph().with_config(config).build(&tris))
+            let b = Builder::lsph().with_config(config);
+            ("lsph", b.build(&tris), b.for_wide().build(&tris))
         };
+        assert_eq!(
+            for_wide.as_ref().err(),
+            result.as_ref().err(),
+            "{name} for_wide"
+        );
         match (result, expect_err) {
-            (Ok(bvh), None) => built.push((format!("{name} {config:?}"), bvh, config.max_depth)),
+            (Ok(bvh), None) => {
+                let pruned = for_wide.expect("same outcome as the full build");
+                assert_eq!(
+                    WideBvh::from_binary(&pruned, &tris).nodes(),
+                    WideBvh::from_binary(&bvh, &tris).nodes(),
+                    "{name} {config:?}: for_wide collapses otherwise"
+                );
+                built.push((format!("{name} {config:?}"), bvh, config.max_depth))
+            }
             (Err(e), Some(x)) => assert_eq!(e, x, "{name}"),
             (r, x) => panic!(
                 "{name} {config:?}: got {:?}, expected error {x:?}",

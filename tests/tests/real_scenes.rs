@@ -137,6 +137,14 @@ fn run_scene(relative: &str, rays_per_kind: usize) -> Option<Report> {
     // The 4-wide collapse of the SAH tree, with its own leaf-ordered triangle blocks.
     let wide = WideBvh::from_binary(&sah, tris);
     check_wide_structure(&wide, &sah, tris);
+    // A tree built for the collapse alone (nodes of at most four triangles unsplit) collapses to
+    // the same wide nodes.
+    let for_wide = Builder::sah().for_wide().build(tris).unwrap();
+    assert_eq!(
+        WideBvh::from_binary(&for_wide, tris).nodes(),
+        wide.nodes(),
+        "{relative}: the tree built for_wide collapses to other wide nodes"
+    );
     for (i, ray) in rays.iter().enumerate() {
         if i % stride == 0 {
             let oracle = Oracle::new(ray, tris);

@@ -64,10 +64,9 @@ impl WideNode {
     }
 }
 
-/// Largest binary subtree the collapse may turn into one leaf (two [`Triangle4`] blocks). A subtree
-/// of at most four triangles always becomes a leaf of one block: one 4-wide test replaces the
-/// subtree's box tests and its one or two scalar leaf tests. One of five to eight triangles
-/// becomes a leaf of two blocks when splitting it would save little (see [`MERGE_RATIO`]).
+/// Largest binary subtree the collapse may turn into one leaf (two [`Triangle4`] blocks). One of
+/// five to eight triangles becomes a leaf of two blocks when splitting it would save little (see
+/// [`MERGE_RATIO`]); one of at most [`WideBvh::ONE_BLOCK`] always becomes a leaf.
 const LEAF_BLOCK: usize = 8;
 
 /// A subtree of five to eight triangles becomes one leaf when its children, weighted by their
@@ -91,6 +90,12 @@ pub struct WideBvh {
 }
 
 impl WideBvh {
+    /// A binary subtree of at most this many triangles always becomes one leaf of the wide tree,
+    /// in one [`Triangle4`] block, whatever its shape: one 4-wide test replaces the subtree's box
+    /// tests and its one or two scalar leaf tests. So a binary build meant only for the collapse
+    /// need not split such nodes ([`crate::build::Builder::for_wide`]).
+    pub const ONE_BLOCK: u32 = 4;
+
     /// Collapses a binary BVH built over `tris`: each wide node takes a binary node's children and
     /// keeps opening the inner child of largest surface area (the one a ray is likeliest to enter)
     /// until it has four. A binary subtree of at most four triangles becomes one leaf of one
@@ -240,7 +245,7 @@ fn subtree_sizes(bvh: &Bvh) -> Vec<u8> {
 }
 
 /// True when binary node `b` becomes a leaf of the wide tree: a binary leaf, a subtree of at most
-/// four triangles, or one of at most [`LEAF_BLOCK`] that [`MERGE_RATIO`] says not to split.
+/// [`WideBvh::ONE_BLOCK`] triangles, or one of at most [`LEAF_BLOCK`] that [`MERGE_RATIO`] says not to split.
 /// `sizes` is [`subtree_sizes`]'s.
 fn is_wide_leaf(bvh: &Bvh, sizes: &[u8], b: u32) -> bool {
     let node = &bvh.nodes[b as usize];
@@ -251,7 +256,7 @@ fn is_wide_leaf(bvh: &Bvh, sizes: &[u8], b: u32) -> bool {
     if n > LEAF_BLOCK {
         return false;
     }
-    if n <= 4 {
+    if n <= WideBvh::ONE_BLOCK as usize {
         return true;
     }
     // Blocks a ray entering child `c` tests, weighted by the chance that it enters (a child of
@@ -295,4 +300,72 @@ fn small_subtree(bvh: &Bvh, b: u32) -> Option<([u32; LEAF_BLOCK], usize)> {
         }
     }
     Some((ids, n))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::build::{BinSpace, BuildConfig, Builder, CutEvaluation, ThesisCut};
+    use crate::heuristics::{AxisChooser, CostModel, LeafSize, Termination};
+    use crate::test_scenes::soup;
+
+    /// The ids of each leaf slot's blocks, sorted: what a leaf holds, whatever its grouping.
+    fn leaf_sets(wide: &WideBvh) -> Vec<Vec<u32>> {
+        let mut sets = Vec::new();
+        for node in wide.nodes() {
+            for slot in 0..4 {
+                let (first, count) = (node.child[slot] as usize, node.count[slot] as usize);
+                if count == 0 {
+                    continue;
+                }
+                let blocks = &wide.triangles()[first..first + count.div_ceil(4)];
+                let mut ids: Vec<u32> = blocks.iter().flat_map(|b| b.id).collect();
+                ids.truncate(count);
+                ids.sort_unstable();
+                sets.push(ids);
+            }
+        }
+        sets
+    }
+
+    fn same_collapse<A, C, T>(builder: Builder<A, C, T>, tris: &[Triangle])
+    where
+        A: AxisChooser + Clone,
+        C: CostModel + Clone,
+        T: Termination + Clone,
+    {
+        let full = builder.clone().build(tris).unwrap();
+        let pruned = builder.for_wide().build(tris).unwrap();
+        let (a, b) = (
+            WideBvh::from_binary(&full, tris),
+            WideBvh::from_binary(&pruned, tris),
+        );
+        assert_eq!(a.nodes(), b.nodes(), "{} triangles", tris.len());
+        assert_eq!(a.max_depth(), b.max_depth());
+        assert_eq!(leaf_sets(&a), leaf_sets(&b));
+        if tris.len() > 4 {
+            assert!(pruned.nodes().len() < full.nodes().len());
+        }
+    }
+
+    #[test]
+    fn a_tree_built_for_wide_collapses_to_the_same_wide_tree() {
+        let thesis = BuildConfig {
+            cut: CutEvaluation::Thesis(ThesisCut::SPFH),
+            bin_space: BinSpace::NodeBox,
+            ..BuildConfig::default()
+        };
+        for (n, seed) in [(1, 1), (3, 2), (4, 3), (5, 4), (9, 5), (200, 6), (3000, 7)] {
+            for spread in [0.05, 2.0] {
+                let tris = soup(n, seed, -10.0, 10.0, spread);
+                same_collapse(Builder::sah(), &tris);
+                same_collapse(Builder::lsph(), &tris);
+                same_collapse(
+                    Builder::sah().with_termination(LeafSize { max_leaf: 2 }),
+                    &tris,
+                );
+                same_collapse(Builder::sah().with_config(thesis), &tris);
+            }
+        }
+    }
 }

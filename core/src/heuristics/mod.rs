@@ -73,4 +73,4 @@ pub use cost::{CostConstants, CostModel, Sah};
 pub use pah_ortho::PahOrtho;
 pub use pah_perspective::{PahPerspective, PerspectiveMeasure};
 pub use spfh::Spfh;
-pub use termination::{LeafSize, SahTermination, Termination};
+pub use termination::{LeafSize, MinLeaf, SahTermination, Termination};

@@ -53,3 +53,25 @@ impl Termination for LeafSize {
         false
     }
 }
+
+/// Another rule, plus: a node of at most `min_leaf` primitives is a leaf at once, before any split
+/// is priced (Embree's minimum leaf size). For trees that are collapsed afterwards, where what a
+/// small node would split into is thrown away ([`crate::build::Builder::for_wide`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MinLeaf<T> {
+    /// The rule for every larger node.
+    pub inner: T,
+    /// Nodes of at most this many primitives are leaves.
+    pub min_leaf: u32,
+}
+
+impl<T: Termination> Termination for MinLeaf<T> {
+    #[inline]
+    fn must_stop(&self, count: u32, depth: u32) -> bool {
+        count <= self.min_leaf || self.inner.must_stop(count, depth)
+    }
+    #[inline]
+    fn prefer_leaf(&self, count: u32, leaf_cost: f32, split_cost: f32) -> bool {
+        self.inner.prefer_leaf(count, leaf_cost, split_cost)
+    }
+}

@@ -55,11 +55,18 @@ impl PlaneArea {
             return Err(AreaError::NotFinite("center"));
         }
         if polytope.scale > MAX_AREA_COORDINATE {
-            let key = if depth > half_width.max(half_height) {
-                "depth"
-            } else {
-                "center"
-            };
+            // The key of the largest term of the reach (an extent before the centre on a tie).
+            let terms = [
+                (depth, "depth"),
+                (half_width, "half_width"),
+                (half_height, "half_height"),
+                (center.abs().max_element(), "center"),
+            ];
+            let (_, key) =
+                terms.into_iter().fold(
+                    (f32::NEG_INFINITY, "depth"),
+                    |a, b| if b.0 > a.0 { b } else { a },
+                );
             return Err(AreaError::TooLarge(key));
         }
         Ok(Self {
@@ -130,6 +137,23 @@ mod tests {
 
     fn area() -> PlaneArea {
         PlaneArea::new(Vec3::new(5.0, 5.0, -4.0), Vec3::Z, 5.0, 5.0, 20.0).unwrap()
+    }
+
+    #[test]
+    fn a_reach_too_large_names_its_largest_term() {
+        let c = Vec3::new(5.0, 5.0, -4.0);
+        let too_large = |c: Vec3, w: f32, h: f32, d: f32| PlaneArea::new(c, Vec3::Z, w, h, d);
+        for (made, key) in [
+            (too_large(c, 1e30, 5.0, 20.0), "half_width"),
+            (too_large(c, 5.0, 1e30, 20.0), "half_height"),
+            (too_large(c, 5.0, 5.0, 1e30), "depth"),
+            (
+                too_large(Vec3::new(0.0, 1e19, 0.0), 5.0, 5.0, 20.0),
+                "center",
+            ),
+        ] {
+            assert_eq!(made, Err(AreaError::TooLarge(key)));
+        }
     }
 
     #[test]

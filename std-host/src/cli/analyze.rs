@@ -13,7 +13,10 @@ use serde_json::{json, Value};
 
 use super::areas::load_areas;
 use super::{load_scene, CliError};
-use crate::experiment::{build_fallback, run_one, sample_rays, RunMetrics, RunSetup, Settings};
+use crate::experiment::{
+    build_fallback, run_one, sample_rays, settings_of, ExperimentError, RunMetrics, RunSetup,
+    Settings,
+};
 
 /// The per-node columns `--nodes FILE.csv` can write.
 pub const NODE_COLUMNS: [&str; 17] = [
@@ -48,10 +51,13 @@ pub struct AnalyzeArgs {
     /// The local BVH's preset: full, longest, facing, standard or sah.
     #[arg(long, value_name = "NAME", default_value = "full")]
     pub preset: String,
-    /// Rays traced per area for the measured costs.
-    #[arg(long, value_name = "N", default_value_t = 1000, value_parser = clap::value_parser!(u32).range(1..))]
-    pub rays: u32,
-    /// The thesis's builder, constants, fallback and ray sampler (as `experiment --thesis-mode`).
+    /// Rays traced per area for the measured costs (default: the file's
+    /// [settings].rays_per_config, else 1000).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub rays: Option<u32>,
+    /// The thesis's builder, constants, fallback and ray sampler (as `experiment --thesis-mode`,
+    /// with the builder keys of the file's [settings] when it has them, as an experiment file
+    /// does).
     #[arg(long)]
     pub thesis_mode: bool,
     /// Print one JSON object instead of the table.
@@ -74,12 +80,14 @@ pub struct AnalyzeArgs {
     pub columns: Option<Vec<String>>,
 }
 
-fn setup(args: &AnalyzeArgs) -> RunSetup {
+/// The run set-up of `experiment` for the areas file's `[settings]` (see [`settings_of`]) and
+/// the arguments.
+fn setup(args: &AnalyzeArgs, file: &Settings) -> RunSetup {
     use rdbvh_core::build::PresetOptions;
     use rdbvh_core::influence::PointDistribution;
     let s = Settings {
-        rays_per_config: args.rays,
-        ..Settings::default()
+        rays_per_config: args.rays.unwrap_or(file.rays_per_config),
+        ..file.clone()
     };
     let local = s.preset_options(args.thesis_mode);
     RunSetup {
@@ -95,7 +103,7 @@ fn setup(args: &AnalyzeArgs) -> RunSetup {
             Preset::Sah
         },
         constants: s.constants(args.thesis_mode),
-        rays: args.rays,
+        rays: s.rays_per_config,
         octree_levels: s.octree_levels,
         point_distribution: if args.thesis_mode {
             PointDistribution::YawPitch
@@ -329,7 +337,10 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
     }
     let (scene, _) = load_scene(&args.scene)?;
     let entries = load_areas(&args.areas, &scene)?;
-    let setup = setup(args);
+    // Read again for its [settings] (load_areas has read it whole already).
+    let text = std::fs::read_to_string(&args.areas)
+        .map_err(|e| ExperimentError::Io(args.areas.clone(), e.to_string()))?;
+    let setup = setup(args, &settings_of(&text, &args.areas)?);
     let fallback = build_fallback(&scene.triangles, &setup)?;
     let mut reports = Vec::new();
     for (i, entry) in entries.iter().enumerate() {

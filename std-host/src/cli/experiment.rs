@@ -18,9 +18,16 @@ relative to FILE.toml; a config without `file` is skipped with a note, a named f
 be read is an error) with every heuristic of [settings].heuristics, in parallel, and writes
 DIR/results.csv (one row per run, the thesis's columns first), DIR/report.md and charts (SVG
 and PNG).
-Every [settings] key is optional; rays_per_config and heuristics apply in every mode, the builder
-keys (candidate_planes, max_triangles_per_leaf, inner_node_cost, triangle_cost, thresholds) only
-with --thesis-mode. Charts have text when a TTF font is found (RDBVH_FONT=path, or DejaVu Sans).")]
+Every [settings] key is optional; rays_per_config, heuristics and octree_levels apply in every
+mode, the builder keys (candidate_planes, max_triangles_per_leaf, max_levels (the depth limit, at
+most 64), inner_node_cost, triangle_cost, thresholds) only with --thesis-mode. Unknown keys and
+tables are errors.
+A run is named by its config's thesis_test, else SCENE_KIND_ORIENTATION, plus the heuristic; two
+configs with one name are an error. orientation (parallel, 15deg, 45deg or oblique) puts a run in
+its group of the report; a run without one is in results.csv and the estimate errors by kind, in
+no group table. A config's rays are seeded by its position in the file (the Nth config, whatever
+the others), so a file cut down to some of its configs traces other rays for them.
+Charts have text when a TTF font is found (RDBVH_FONT=path, or DejaVu Sans).")]
 pub struct ExperimentArgs {
     /// The experiment file.
     #[arg(value_name = "FILE.toml")]
@@ -42,12 +49,12 @@ pub struct ExperimentArgs {
     /// The thesis's results folder (its Plane_*.csv and Point_*.csv): shown beside ours.
     #[arg(long, value_name = "DIR")]
     pub thesis_results: Option<PathBuf>,
-    /// Candidate planes per axis in thesis mode, 1 to 63 (overrides candidate_planes).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32)
+    /// Candidate planes per axis, 1 to 63 (overrides candidate_planes; needs --thesis-mode).
+    #[arg(long, value_name = "N", requires = "thesis_mode", value_parser = clap::value_parser!(u32)
         .range(1..=i64::from(crate::experiment::MAX_CANDIDATE_PLANES)))]
     pub candidate_planes: Option<u32>,
-    /// Largest leaf in thesis mode (overrides max_triangles_per_leaf).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    /// Largest leaf (overrides max_triangles_per_leaf; needs --thesis-mode).
+    #[arg(long, value_name = "N", requires = "thesis_mode", value_parser = clap::value_parser!(u32).range(1..))]
     pub max_leaf: Option<u32>,
     /// Octree levels, 1 to 10 (overrides octree_levels).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32)
@@ -100,7 +107,7 @@ pub fn run(args: &ExperimentArgs, out: &mut dyn Write) -> Result<(), CliError> {
     .map_err(w)?;
     let (c, n) = cheaper_groups(&s.ours.structure_over_fallback);
     let structure = if n == 0 {
-        "no `full` run to compare the structure with the fallback BVH alone".to_string()
+        s.no_structure_comparison().to_string()
     } else {
         format!("full structure cheaper than the fallback BVH alone in {c} of {n} groups")
     };

@@ -43,8 +43,8 @@ pub use error::ExperimentError;
 pub use plots::fonts_available;
 pub use results::{header, read_table, read_thesis_results, RunRow, Table, THESIS_COLUMNS};
 pub use run::{build_fallback, run_one, sample_rays, RunMetrics, RunSetup};
-pub use settings::{parse_presets, ExperimentFile, Settings, MAX_CANDIDATE_PLANES};
-pub use summary::{cheaper_groups, findings, Findings, RunKey, GROUPS};
+pub use settings::{parse_presets, settings_of, ExperimentFile, Settings, MAX_CANDIDATE_PLANES};
+pub use summary::{cheaper_groups, findings, pair_thesis, Findings, Pairing, RunKey, GROUPS};
 
 use std::collections::HashMap;
 use std::io::Write;
@@ -103,18 +103,48 @@ pub struct ExperimentSummary {
     pub ours: Findings,
     /// The thesis's findings over the same runs, when its results were given.
     pub thesis: Option<Findings>,
+    /// How our runs found the thesis's rows, when its results were given.
+    pub pairing: Option<Pairing>,
     /// Wall-clock seconds.
     pub seconds: f64,
 }
 
-fn orientation_name(o: Option<&str>) -> String {
-    match o.unwrap_or("").to_ascii_lowercase().as_str() {
-        "parallel" => "Parallel".into(),
-        "15deg" | "15" => "15".into(),
-        "45deg" | "45" => "45".into(),
-        "oblique" => "Oblique".into(),
-        "" => "Unknown".into(),
-        other => other.into(),
+impl ExperimentSummary {
+    /// Runs without an `orientation`, which join no group table (their rows are in
+    /// `results.csv`).
+    pub fn ungrouped_runs(&self) -> usize {
+        self.rows
+            .iter()
+            .filter(|r| r.orientation == "Unknown")
+            .count()
+    }
+
+    /// Why the structure could not be compared with the fallback BVH alone in any group: no
+    /// `full` run at all, or none with an orientation.
+    pub fn no_structure_comparison(&self) -> &'static str {
+        if self
+            .rows
+            .iter()
+            .any(|r| r.heuristic == Preset::Full.thesis_name())
+        {
+            "no `full` run has an orientation (parallel, 15deg, 45deg or oblique), so none joins a \
+             group to compare the structure with the fallback BVH alone"
+        } else {
+            "no `full` run to compare the structure with the fallback BVH alone"
+        }
+    }
+}
+
+/// The report's group of an `orientation` value (any case): `Unknown` for none, `None` for a
+/// value that names no group (the experiment file is refused).
+pub(crate) fn orientation_group(o: Option<&str>) -> Option<&'static str> {
+    match o.map(str::to_ascii_lowercase).as_deref() {
+        Some("parallel") => Some("Parallel"),
+        Some("15deg" | "15") => Some("15"),
+        Some("45deg" | "45") => Some("45"),
+        Some("oblique") => Some("Oblique"),
+        None => Some("Unknown"),
+        Some(_) => None,
     }
 }
 
@@ -125,9 +155,9 @@ fn kind_name(a: &InfluenceArea) -> &'static str {
     }
 }
 
-/// The run key of a configuration and preset: the thesis's run name and its group.
-pub fn run_key(entry: &AreaEntry, preset: Preset) -> RunKey {
-    let scene = entry
+/// A configuration's scene name: `scene`, else `file` without its extension, else `configN`.
+fn scene_name(entry: &AreaEntry) -> String {
+    entry
         .scene
         .clone()
         .or_else(|| {
@@ -137,18 +167,34 @@ pub fn run_key(entry: &AreaEntry, preset: Preset) -> RunKey {
                     .to_string()
             })
         })
-        .unwrap_or_else(|| format!("config{}", entry.index + 1));
-    let kind = kind_name(&entry.area).to_string();
-    let orientation = orientation_name(entry.orientation.as_deref());
-    let base = entry
-        .thesis_test
-        .clone()
-        .unwrap_or_else(|| format!("{scene}_{kind}_{orientation}"));
+        .unwrap_or_else(|| format!("config{}", entry.index + 1))
+}
+
+/// A configuration's orientation group (`Unknown` without one, or for a value that names none).
+fn orientation_name(entry: &AreaEntry) -> &'static str {
+    orientation_group(entry.orientation.as_deref()).unwrap_or("Unknown")
+}
+
+/// A configuration's run name before the preset's suffix: its `thesis_test`, else
+/// `SCENE_KIND_ORIENTATION`. Unique within an experiment file (checked when it is read).
+pub(crate) fn run_base_name(entry: &AreaEntry) -> String {
+    entry.thesis_test.clone().unwrap_or_else(|| {
+        format!(
+            "{}_{}_{}",
+            scene_name(entry),
+            kind_name(&entry.area),
+            orientation_name(entry)
+        )
+    })
+}
+
+/// The run key of a configuration and preset: the thesis's run name and its group.
+pub fn run_key(entry: &AreaEntry, preset: Preset) -> RunKey {
     RunKey {
-        name: format!("{base}_{}", preset.thesis_name()),
-        scene,
-        kind,
-        orientation,
+        name: format!("{}_{}", run_base_name(entry), preset.thesis_name()),
+        scene: scene_name(entry),
+        kind: kind_name(&entry.area).to_string(),
+        orientation: orientation_name(entry).to_string(),
         heuristic: preset.thesis_name().to_string(),
     }
 }
@@ -224,6 +270,10 @@ pub fn run_experiment(
     let mut runnable: Vec<(&AreaEntry, PathBuf)> = Vec::new();
     for e in &file.configs {
         match &e.file {
+            // A built-in scene is a name, not a file under scene_dir.
+            Some(f) if f.starts_with(crate::scene::BUILTIN_PREFIX) => {
+                runnable.push((e, PathBuf::from(f)))
+            }
             Some(f) => runnable.push((e, file.scene_dir.join(f))),
             None => {
                 let name = e
@@ -328,6 +378,9 @@ pub fn run_experiment(
     rows.sort_by_key(|(i, p, _)| (*i, *p));
     let rows: Vec<RunRow> = rows.into_iter().map(|(_, _, r)| r).collect();
 
+    // Every run succeeded: the earlier run's outputs go now, so a run stopped from here on
+    // leaves its own files only (a failed run leaves the earlier ones whole).
+    report::clear_outputs(&opts.out)?;
     let results = opts.out.join("results.csv");
     results::write_results(&results, &rows)?;
 
@@ -343,9 +396,14 @@ pub fn run_experiment(
         .collect();
     let ours_table = read_table(&results)?;
     let ours = findings(&ours_table, &keys);
-    let thesis = match &opts.thesis_results {
-        Some(dir) => Some(findings(&read_thesis_results(dir)?, &keys)),
-        None => None,
+    let (thesis, pairing) = match &opts.thesis_results {
+        Some(dir) => {
+            let table = read_thesis_results(dir)?;
+            let (paired, pairing) =
+                pair_thesis(&table, &ours_table, &keys, settings.rays_per_config);
+            (Some(findings(&paired, &keys)), Some(pairing))
+        }
+        None => (None, None),
     };
 
     // The top-level studies over the file's areas (every configuration has one, scene or not).
@@ -367,6 +425,7 @@ pub fn run_experiment(
         skipped,
         ours,
         thesis,
+        pairing,
         seconds: start.elapsed().as_secs_f64(),
     };
     report::write_report(&opts.out, opts, &settings, &summary, &levels, &counts)?;

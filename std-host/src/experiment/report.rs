@@ -20,6 +20,39 @@ fn group_names() -> Vec<String> {
     GROUPS.iter().map(|(k, o)| format!("{k} {o}")).collect()
 }
 
+/// The charts' file stems (each written as `.svg` and `.png`).
+const CHARTS: [&str; 6] = [
+    "estimate_error",
+    "spfh_vs_lsph",
+    "structure_vs_fallback",
+    "octree_levels_error",
+    "octree_levels_lookup",
+    "octree_vs_list",
+];
+
+/// Removes an earlier run's `results.csv`, `report.md` and charts from `dir`, before a run
+/// writes its own: a run stopped while writing leaves only its own files, never a new
+/// `results.csv` beside an old report.
+pub fn clear_outputs(dir: &Path) -> Result<(), ExperimentError> {
+    let files = ["results.csv".to_string(), "report.md".to_string()]
+        .into_iter()
+        .chain(
+            CHARTS
+                .iter()
+                .flat_map(|stem| [format!("{stem}.svg"), format!("{stem}.png")]),
+        );
+    for f in files {
+        let path = dir.join(f);
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(ExperimentError::Io(path, e.to_string()))
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 /// Writes `dir/report.md` and the charts.
 pub fn write_report(
     dir: &Path,
@@ -34,9 +67,18 @@ pub fn write_report(
     let t = |f: fn(&super::Findings) -> &PerGroup, g: usize| th.and_then(|x| f(x)[g]);
     let mut md = String::new();
     let mode = if opts.thesis_mode {
-        "thesis mode (the thesis's builder settings from the file)"
+        format!(
+            "thesis mode (the thesis's builder: {} candidate planes per axis, leaves of up to {} \
+             triangles, depth limit {}, inner node cost {} counted twice, triangle cost {}; from \
+             the file's [settings] and the command line)",
+            settings.candidate_planes,
+            settings.max_triangles_per_leaf,
+            settings.max_levels.min(rdbvh_core::bvh::MAX_DEPTH),
+            settings.inner_node_cost,
+            settings.triangle_cost
+        )
     } else {
-        "project mode (binned builder, project defaults)"
+        "project mode (binned builder, project defaults)".to_string()
     };
     let _ = writeln!(md, "# Experiment report\n");
     let _ = writeln!(
@@ -51,11 +93,30 @@ pub fn write_report(
     for note in &s.skipped {
         let _ = writeln!(md, "- skipped: {note}");
     }
-    if th.is_some() {
+    let ungrouped = s.ungrouped_runs();
+    if ungrouped > 0 {
         let _ = writeln!(
             md,
-            "- thesis columns: the thesis's own results over the same runs (same run names)"
+            "- {ungrouped} runs have no `orientation` and join no group table (their rows are in \
+             results.csv; the estimate errors by kind include them)"
         );
+    }
+    if let Some(p) = &s.pairing {
+        let _ = writeln!(
+            md,
+            "- thesis columns: the thesis's own results over the same runs (same run names): {} \
+             of our {} runs found theirs",
+            p.matched, p.runs
+        );
+        if !p.excluded.is_empty() {
+            let _ = writeln!(
+                md,
+                "- left out of the thesis columns, as the thesis's row of that name measured \
+                 another area (its hit fraction differs from ours by more than sampling \
+                 explains): {}",
+                p.excluded.join(", ")
+            );
+        }
     }
     if !fonts_available() {
         let _ = writeln!(
@@ -106,11 +167,7 @@ pub fn write_report(
     let (c, n) = cheaper_groups(&ours.structure_over_fallback);
     if n == 0 {
         // Without `full` runs there is no structure to compare ("in 0 of 0 groups").
-        let _ = writeln!(
-            md,
-            "\nNo group ran the full structure (preset `full`): it is not compared with the \
-             fallback BVH alone."
-        );
+        let _ = writeln!(md, "\nNot compared: {}.", s.no_structure_comparison());
     } else {
         let _ = write!(
             md,
@@ -153,14 +210,7 @@ pub fn write_report(
         );
     }
     let _ = writeln!(md, "\n## Charts\n");
-    for stem in [
-        "estimate_error",
-        "spfh_vs_lsph",
-        "structure_vs_fallback",
-        "octree_levels_error",
-        "octree_levels_lookup",
-        "octree_vs_list",
-    ] {
+    for stem in CHARTS {
         let _ = writeln!(md, "- ![{stem}]({stem}.svg) ([PNG]({stem}.png))");
     }
     let path = dir.join("report.md");

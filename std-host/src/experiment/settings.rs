@@ -1,12 +1,13 @@
 //! The experiment file: `scene_dir`, `[settings]` and the `[[config]]` entries.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use rdbvh_core::build::{Preset, PresetOptions, ThesisCut};
 use rdbvh_core::heuristics::CostConstants;
 use serde::Deserialize;
 
-use super::ExperimentError;
+use super::{orientation_group, run_base_name, ExperimentError};
 use crate::areas::{parse_areas, AreaEntry, AreasErrorKind, TableKind};
 
 /// `[settings]`: every key is optional. `rays_per_config` and `heuristics` apply in every mode;
@@ -24,8 +25,9 @@ pub struct Settings {
     pub candidate_planes: u32,
     /// Largest leaf (thesis mode; default 2).
     pub max_triangles_per_leaf: u32,
-    /// The thesis's depth limit (default 100). This project's builders bound depth at 64
-    /// (`rdbvh_core::bvh::MAX_DEPTH`); the value is reported, not used.
+    /// The thesis's depth limit (thesis mode; default 100, clamped to this project's bound of 64,
+    /// `rdbvh_core::bvh::MAX_DEPTH`). A limit below what the leaf size needs makes the nodes at
+    /// it leaves of any size, as in the thesis's builder.
     pub max_levels: u32,
     /// Octree levels of the top-level structure (every mode; default 5).
     pub octree_levels: u32,
@@ -235,12 +237,20 @@ fn settings_line(text: &str, key: &str) -> Option<usize> {
     None
 }
 
+/// The file's top level. Unknown keys are errors: a misspelt `[setting]` table would otherwise
+/// run every setting at its default without a word. The `[[config]]` (and `[[area]]`) tables are
+/// read by [`parse_areas`], which checks their keys.
 #[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct Top {
     #[serde(default)]
     scene_dir: Option<String>,
     #[serde(default)]
     settings: Settings,
+    #[serde(default, rename = "config")]
+    _config: Option<toml::Value>,
+    #[serde(default, rename = "area")]
+    _area: Option<toml::Value>,
 }
 
 /// A parsed experiment file.
@@ -267,18 +277,7 @@ impl ExperimentFile {
 
     /// Parses an experiment file's text; `path` locates `scene_dir` and labels errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self, ExperimentError> {
-        let top: Top = toml::from_str(text).map_err(|e| {
-            // The line of the offending key or value, when the parser says where it is.
-            let line = e
-                .span()
-                .map(|at| format!(" line {}", text[..at.start].matches('\n').count() + 1))
-                .unwrap_or_default();
-            ExperimentError::Settings(format!(
-                "{}{line}: {}",
-                path.display(),
-                e.message().lines().next().unwrap_or("invalid TOML")
-            ))
-        })?;
+        let top: Top = toml::from_str(text).map_err(|e| toml_error(&e, text, path))?;
         top.settings.check(text, path)?;
         let areas = parse_areas(text, path).map_err(|e| match e.kind {
             // The area files' wording names [[area]] tables first; an experiment lists configs.
@@ -296,6 +295,10 @@ impl ExperimentFile {
                 path.display()
             )));
         }
+        for e in &areas.entries {
+            check_orientation(e, path)?;
+        }
+        check_run_names(&areas.entries, path)?;
         let base = path.parent().unwrap_or(Path::new("."));
         let scene_dir = match top.scene_dir {
             Some(d) => base.join(d),
@@ -308,6 +311,71 @@ impl ExperimentFile {
             configs: areas.entries,
         })
     }
+}
+
+/// A TOML error of `text` (read from `path`) with the line of the offending key or value, when
+/// the parser says where it is.
+fn toml_error(e: &toml::de::Error, text: &str, path: &Path) -> ExperimentError {
+    let line = e
+        .span()
+        .map(|at| format!(" line {}", text[..at.start].matches('\n').count() + 1))
+        .unwrap_or_default();
+    ExperimentError::Settings(format!(
+        "{}{line}: {}",
+        path.display(),
+        e.message().lines().next().unwrap_or("invalid TOML")
+    ))
+}
+
+/// The `[settings]` of an area or experiment file's `text` (the defaults without one), checked
+/// as [`ExperimentFile::parse`] checks them: `analyze` reads an experiment file as an area file
+/// and runs its areas with the experiment's settings.
+pub fn settings_of(text: &str, path: &Path) -> Result<Settings, ExperimentError> {
+    #[derive(Deserialize)]
+    struct Only {
+        #[serde(default)]
+        settings: Settings,
+    }
+    let only: Only = toml::from_str(text).map_err(|e| toml_error(&e, text, path))?;
+    only.settings.check(text, path)?;
+    Ok(only.settings)
+}
+
+/// An `orientation` must name one of the thesis's groups (or be left out): it decides which
+/// group a run joins, and an unknown one would drop the run from every group table.
+fn check_orientation(e: &AreaEntry, path: &Path) -> Result<(), ExperimentError> {
+    match e.orientation.as_deref() {
+        Some(o) if orientation_group(Some(o)).is_none() => Err(ExperimentError::Areas(format!(
+            "{} line {}: config {}: orientation \"{o}\" is not one of \"parallel\", \"15deg\", \
+             \"45deg\", \"oblique\" (it names the run's group in the report)",
+            path.display(),
+            e.line,
+            e.index
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// Two configurations with one run name (the same `thesis_test`, or without one the same scene,
+/// kind and orientation) would give `results.csv` two rows of each name, of which the report
+/// could only take one.
+fn check_run_names(entries: &[AreaEntry], path: &Path) -> Result<(), ExperimentError> {
+    let mut seen: HashMap<String, &AreaEntry> = HashMap::new();
+    for e in entries {
+        let name = run_base_name(e);
+        if let Some(first) = seen.insert(name.clone(), e) {
+            return Err(ExperimentError::Areas(format!(
+                "{} line {}: config {} has the run name {name} of config {} (line {}): give one \
+                 of them its own thesis_test",
+                path.display(),
+                e.line,
+                e.index,
+                first.index,
+                first.line
+            )));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -355,6 +423,57 @@ mod tests {
         assert_eq!(
             parse_presets(["Full", "full", "standard"]).unwrap(),
             vec![Preset::Full, Preset::Standard]
+        );
+    }
+
+    #[test]
+    fn run_names_orientations_and_top_level_keys_are_checked() {
+        let config = |extra: &str| {
+            format!(
+                "[[config]]\nkind = \"plane\"\nfile = \"a.obj\"\n{extra}center = [0.0, 0.0, 0.0]\n\
+                 normal = [0.0, 0.0, 1.0]\nhalf_width = 1.0\nhalf_height = 1.0\ndepth = 1.0\n"
+            )
+        };
+        let parse = |text: &str| ExperimentFile::parse(text, Path::new("e.toml"));
+        // Two lights on one scene and orientation: one run name, refused with both lines.
+        let two = format!("{}{}", config(""), config(""));
+        let e = parse(&two).unwrap_err().to_string();
+        assert!(
+            e.starts_with(
+                "e.toml line 9: config 1 has the run name a_Plane_Unknown of config 0 (line 1)"
+            ),
+            "{e}"
+        );
+        let named = format!(
+            "{}{}",
+            config("thesis_test = \"x\"\n"),
+            config("thesis_test = \"y\"\n")
+        );
+        assert!(parse(&named).is_ok());
+        // An orientation must name a group; any case of a known one does.
+        let e = parse(&config("orientation = \"45 deg\"\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("orientation \"45 deg\" is not one of"), "{e}");
+        assert!(parse(&config("orientation = \"PARALLEL\"\n")).is_ok());
+        // A misspelt table or a setting at the top level is an error, not the defaults.
+        for bad in ["[setting]\nrays_per_config = 3\n", "rays_per_config = 3\n"] {
+            let e = parse(&format!("{bad}{}", config("")))
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with("e.toml line 1: unknown field"), "{e}");
+        }
+        // `analyze` reads the same [settings] from the file.
+        let text = format!("[settings]\ncandidate_planes = 7\n{}", config(""));
+        assert_eq!(
+            settings_of(&text, Path::new("e.toml"))
+                .unwrap()
+                .candidate_planes,
+            7
+        );
+        assert_eq!(
+            settings_of(&config(""), Path::new("e.toml")).unwrap(),
+            Settings::default()
         );
     }
 

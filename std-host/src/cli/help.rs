@@ -47,8 +47,8 @@ Area files (TOML): one [[area]] table per influence area, with the keys of an ex
   fov_y_deg = 60.0
   near = 0.1
   far = 9.4
-The keys scene, file, orientation and thesis_test are allowed and ignored, so an entry can be
-pasted from experiments.toml. A file of [[config]] tables instead (experiments.toml itself) is a
+The keys scene, file, orientation and thesis_test are allowed and ignored here (experiment
+reads them: see its help), so an entry can be pasted from experiments.toml. A file of [[config]] tables instead (experiments.toml itself) is a
 list of experiments: only the entries whose `file` names the scene (same file name without
 extension, any case; builtin:random100 takes Random100.obj's) are used.";
 

@@ -97,7 +97,7 @@ pub struct ExperimentOptions {
 pub struct ExperimentSummary {
     /// One row per run, in file and preset order.
     pub rows: Vec<RunRow>,
-    /// Configurations skipped and why.
+    /// Configurations skipped and why, and areas that hold no triangle of their scene.
     pub skipped: Vec<String>,
     /// Our findings.
     pub ours: Findings,
@@ -376,6 +376,24 @@ pub fn run_experiment(
         .collect::<Result<_, ExperimentError>>()?;
     bar.finish_and_clear();
     rows.sort_by_key(|(i, p, _)| (*i, *p));
+    // An area that holds no triangle of its scene runs, with rows of zeros: say so.
+    let mut empty: Vec<usize> = rows
+        .iter()
+        .filter(|(_, _, r)| r.metrics.local_triangles == 0)
+        .map(|(i, _, _)| *i)
+        .collect();
+    empty.dedup();
+    for i in empty {
+        let (entry, path) = &runnable[i];
+        let note = format!(
+            "config {} (line {}): its area holds no triangle of {}, so its runs' rows are zeros",
+            entry.index,
+            entry.line,
+            path.display()
+        );
+        writeln!(log, "note: {note}").ok();
+        skipped.push(note);
+    }
     let rows: Vec<RunRow> = rows.into_iter().map(|(_, _, r)| r).collect();
 
     // Every run succeeded: the earlier run's outputs go now, so a run stopped from here on

@@ -57,8 +57,9 @@ pub struct Bars<'a> {
     pub y_label: &'a str,
     /// Category names.
     pub categories: &'a [String],
-    /// Series names and values.
-    pub series: Vec<(String, Vec<Option<f64>>)>,
+    /// Series: name, colour (an index into `plotters`' `Palette99`, so a series keeps its colour
+    /// whichever others are drawn) and values.
+    pub series: Vec<(String, usize, Vec<Option<f64>>)>,
     /// A horizontal reference line (such as 1 for ratios).
     pub reference: Option<f64>,
 }
@@ -101,12 +102,13 @@ impl Chart for Bars<'_> {
         let ymax = self
             .series
             .iter()
-            .flat_map(|(_, v)| v.iter().flatten())
+            .flat_map(|(_, _, v)| v.iter().flatten())
             .copied()
             .chain(self.reference)
             .fold(0.0f64, f64::max)
             .max(1e-9)
-            * 1.15;
+            // Head room for the legend in the upper right, a line per series, above the bars.
+            * (1.15 + 0.09 * self.series.len() as f64);
         let mut b = ChartBuilder::on(root);
         b.margin(12);
         if text {
@@ -138,8 +140,8 @@ impl Chart for Bars<'_> {
         mesh.draw().map_err(e)?;
         let k = self.series.len().max(1) as f64;
         let w = 0.8 / k;
-        for (s, (name, vals)) in self.series.iter().enumerate() {
-            let color = Palette99::pick(s).to_rgba();
+        for (s, (name, colour, vals)) in self.series.iter().enumerate() {
+            let color = Palette99::pick(*colour).to_rgba();
             let bars = vals.iter().enumerate().filter_map(move |(i, v)| {
                 v.map(|v| {
                     let x0 = i as f64 - 0.4 + s as f64 * w;
@@ -200,8 +202,19 @@ impl Chart for Lines<'_> {
         }
         let mut chart = b.build_cartesian_2d(x0..x1, 0f64..ymax).map_err(e)?;
         let mut mesh = chart.configure_mesh();
+        // Whole-number x values (levels, area counts) read as integers, not `1.0, 2.0`.
+        let whole = pts().all(|p| p.0.fract() == 0.0);
+        let x_fmt = |x: &f64| {
+            if whole {
+                format!("{x:.0}")
+            } else {
+                format!("{x}")
+            }
+        };
         if text {
-            mesh.x_desc(self.x_label).y_desc(self.y_label);
+            mesh.x_desc(self.x_label)
+                .y_desc(self.y_label)
+                .x_label_formatter(&x_fmt);
         } else {
             mesh.x_labels(0).y_labels(0);
         }

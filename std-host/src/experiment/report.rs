@@ -91,7 +91,7 @@ pub fn write_report(
         s.seconds
     );
     for note in &s.skipped {
-        let _ = writeln!(md, "- skipped: {note}");
+        let _ = writeln!(md, "- note: {note}");
     }
     let ungrouped = s.ungrouped_runs();
     if ungrouped > 0 {
@@ -184,7 +184,9 @@ pub fn write_report(
 
     let _ = writeln!(
         md,
-        "\n## Octree levels (every scene's areas; error = false positives / true positives)\n"
+        "\n## Octree levels (one octree per scene name over its configurations' areas, skipped \
+         configurations included: the lookup needs no triangles; error = false positives / true \
+         positives)\n"
     );
     let _ = writeln!(
         md,
@@ -197,7 +199,11 @@ pub fn write_report(
             r.levels, r.error, r.lookup_ns, r.build_us, r.leaves, r.bytes
         );
     }
-    let _ = writeln!(md, "\n## Octree vs list (the file's first N areas)\n");
+    let _ = writeln!(
+        md,
+        "\n## Octree vs list (the file's first N areas, of every configuration and scene, in one \
+         structure: a lookup study, not a scene's)\n"
+    );
     let _ = writeln!(
         md,
         "| areas | octree ns | list ns | octree error |\n|---|---|---|---|"
@@ -218,22 +224,32 @@ pub fn write_report(
 
     // Charts.
     let cats = group_names();
-    let with_thesis = |name: &str, o: PerGroup, t: Option<PerGroup>| {
-        let mut v = vec![(format!("{name} (rdbvh)"), o.to_vec())];
+    // Series `k` is drawn in colour 2k (ours) and 2k + 1 (the thesis's), with or without the
+    // thesis's results beside it.
+    let with_thesis = |name: &str, k: usize, o: PerGroup, t: Option<PerGroup>| {
+        let mut v = vec![(format!("{name} (rdbvh)"), 2 * k, o.to_vec())];
         if let Some(t) = t {
-            v.push((format!("{name} (thesis)"), t.to_vec()));
+            v.push((format!("{name} (thesis)"), 2 * k + 1, t.to_vec()));
         }
         v
     };
-    let mut series = with_thesis("PAH error", ours.pah_error, th.map(|x| x.pah_error));
+    // Titles say the mode, so charts of two runs can be told apart.
+    let mode_tag = if opts.thesis_mode {
+        "thesis mode"
+    } else {
+        "project mode"
+    };
+    let title = |t: &str| format!("{t} ({mode_tag})");
+    let mut series = with_thesis("PAH error", 0, ours.pah_error, th.map(|x| x.pah_error));
     series.extend(with_thesis(
         "SAH error",
+        1,
         ours.sah_error,
         th.map(|x| x.sah_error),
     ));
     save(
         &Bars {
-            title: "Estimate error vs measured all-hit cost",
+            title: &title("Estimate error vs measured all-hit cost"),
             y_label: "relative error",
             categories: &cats,
             series,
@@ -244,11 +260,12 @@ pub fn write_report(
     )?;
     save(
         &Bars {
-            title: "SPFH vs LSPH: facing / standard real cost",
+            title: &title("SPFH vs LSPH: facing / standard real cost"),
             y_label: "cost ratio",
             categories: &cats,
             series: with_thesis(
                 "facing/standard",
+                0,
                 ours.spfh_over_lsph,
                 th.map(|x| x.spfh_over_lsph),
             ),
@@ -259,16 +276,18 @@ pub fn write_report(
     )?;
     let mut series = with_thesis(
         "all-hit",
+        0,
         ours.structure_over_fallback,
         th.map(|x| x.structure_over_fallback),
     );
     series.push((
         "closest-hit (rdbvh)".into(),
+        2,
         ours.structure_over_fallback_closest.to_vec(),
     ));
     save(
         &Bars {
-            title: "Full structure / fallback BVH alone",
+            title: &title("Full structure / fallback BVH alone"),
             y_label: "cost ratio",
             categories: &cats,
             series,
@@ -279,7 +298,7 @@ pub fn write_report(
     )?;
     save(
         &Lines {
-            title: "Octree levels vs containment error",
+            title: &title("Octree levels vs containment error"),
             x_label: "levels",
             y_label: "false / true positives",
             series: vec![(
@@ -295,7 +314,7 @@ pub fn write_report(
     )?;
     save(
         &Lines {
-            title: "Octree levels vs lookup time",
+            title: &title("Octree levels vs lookup time"),
             x_label: "levels",
             y_label: "ns per lookup",
             series: vec![(
@@ -311,7 +330,7 @@ pub fn write_report(
     )?;
     save(
         &Lines {
-            title: "Octree vs list by number of areas",
+            title: &title("Octree vs list by number of areas"),
             x_label: "areas",
             y_label: "ns per lookup",
             series: vec![

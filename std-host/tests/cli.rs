@@ -562,6 +562,25 @@ fn build_with_areas_reports_the_area_build() {
         (thesis["bins"].as_u64(), thesis["max_leaf"].as_u64()),
         (Some(41), Some(2))
     );
+    // Its costs are priced as `analyze --thesis-mode` prices the same tree.
+    let analyzed = json_of(&rdbvh(&[
+        "analyze",
+        "builtin:room",
+        "--preset",
+        "full",
+        "--areas",
+        areas,
+        "--thesis-mode",
+        "--rays",
+        "10",
+        "--json",
+    ]));
+    let first = &analyzed["areas"][0];
+    assert_eq!(first["nodes"], thesis["nodes"]);
+    for key in ["sah_cost", "pah_cost"] {
+        let (a, b) = (thesis[key].as_f64().unwrap(), first[key].as_f64().unwrap());
+        assert!((a - b).abs() <= 1e-5 * b, "{key}: build {a}, analyze {b}");
+    }
     let overridden = json_of(&rdbvh(&[
         "build",
         "builtin:room",

@@ -116,7 +116,13 @@ pub fn run(args: &BuildArgs, out: &mut impl Write) -> Result<(), CliError> {
         .builder
         .build_over(&scene.triangles, subset.as_deref(), area.as_ref())?;
     let triangles = subset.as_ref().map_or(scene.len(), Vec::len);
-    let k = CostConstants::default();
+    // The mode's constants, as `analyze` and `experiment` report them: the thesis's (2 x 1.0 per
+    // inner node, 1.2 per triangle) with --thesis-mode, C_trav = C_isect = 1 otherwise.
+    let k = if args.builder.thesis_mode {
+        CostConstants::THESIS
+    } else {
+        CostConstants::default()
+    };
     let pah_cost = area.as_ref().map(|a| {
         let pah = AreaPah::new(a, args.builder.preset_options().perspective);
         built.bvh.estimated_cost_over(&pah, k, pah.window_measure())

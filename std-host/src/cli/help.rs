@@ -48,9 +48,10 @@ Area files (TOML): one [[area]] table per influence area, with the keys of an ex
   near = 0.1
   far = 9.4
 The keys scene, file, orientation and thesis_test are allowed and ignored here (experiment
-reads them: see its help), so an entry can be pasted from experiments.toml. A file of [[config]] tables instead (experiments.toml itself) is a
-list of experiments: only the entries whose `file` names the scene (same file name without
-extension, any case; builtin:random100 takes Random100.obj's) are used.";
+reads them: see its help), so an entry can be pasted from experiments.toml. A file of [[config]]
+tables instead (experiments.toml itself) is a list of experiments: only the entries whose `file`
+names the scene (same file name without extension, any case; builtin:random100 takes
+Random100.obj's) are used.";
 
 /// `rdbvh build --help`.
 pub fn build() -> String {
@@ -58,8 +59,9 @@ pub fn build() -> String {
         "{PRESETS}\n\n\
          With --areas, the BVH holds only the triangles that overlap the first area that applies to\n\
          the scene (separating-axis test, the scene structure's own), and the report adds pah_cost:\n\
-         the expected cost per ray of the area's rays under its PAH (C_trav = C_isect = 1, like\n\
-         sah_cost).\n\
+         the expected cost per ray of the area's rays under its PAH. Both costs use C_trav =\n\
+         C_isect = 1, or with --thesis-mode the thesis's 2 x 1.0 per inner node and 1.2 per\n\
+         triangle (as analyze and experiment report them).\n\
          --json prints one object with the keys scene, triangles (in the build), scene_triangles,\n\
          nodes, leaves, max_depth, sah_cost, pah_cost, bytes, load_ms, select_ms, build_ms,\n\
          reinsert_ms, reinsert_moved, mtris_per_s, builder, preset, thesis_mode, area_kind, bins,\n\

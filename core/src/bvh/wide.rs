@@ -245,8 +245,8 @@ fn subtree_sizes(bvh: &Bvh) -> Vec<u8> {
 }
 
 /// True when binary node `b` becomes a leaf of the wide tree: a binary leaf, a subtree of at most
-/// [`WideBvh::ONE_BLOCK`] triangles, or one of at most [`LEAF_BLOCK`] that [`MERGE_RATIO`] says not to split.
-/// `sizes` is [`subtree_sizes`]'s.
+/// [`WideBvh::ONE_BLOCK`] triangles, or one of at most [`LEAF_BLOCK`] that [`MERGE_RATIO`] says
+/// not to split. `sizes` is [`subtree_sizes`]'s.
 fn is_wide_leaf(bvh: &Bvh, sizes: &[u8], b: u32) -> bool {
     let node = &bvh.nodes[b as usize];
     if node.is_leaf() {

@@ -264,6 +264,35 @@ mod tests {
     }
 
     #[test]
+    fn answers_past_one_chunk_keep_their_rows_in_order() {
+        // More rows than one group of chunks: each row names its ray, in order.
+        let n = 3 * WRITE_CHUNK * rayon::current_num_threads().max(1) + 17;
+        let hits = (0..n)
+            .map(|i| {
+                (i % 3 != 0).then_some(Hit {
+                    t: i as f32,
+                    triangle: i as u32,
+                    u: 0.5,
+                    v: 0.25,
+                })
+            })
+            .collect();
+        let mut out = Vec::new();
+        Answers::Closest(hits).write_csv(&mut out).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let rows: Vec<&str> = text.lines().skip(1).collect();
+        assert_eq!(rows.len(), n);
+        for (i, row) in rows.iter().enumerate() {
+            let expect = if i % 3 == 0 {
+                format!("{i},,,,")
+            } else {
+                format!("{i},{},{i},0.5,0.25", i as f32)
+            };
+            assert_eq!(*row, expect);
+        }
+    }
+
+    #[test]
     fn parallel_trace_keeps_order_and_agrees_with_brute_force() {
         let tris: Vec<Triangle> = (0..50)
             .map(|i| {

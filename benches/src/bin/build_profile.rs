@@ -1,5 +1,6 @@
-//! `build_profile SCENE [REPS]`: rdbvh's single-threaded SAH build alone, for profilers and quick
-//! before/after checks of the builder. Prints the best thread CPU time of `REPS` builds (default
+//! `build_profile SCENE [REPS] [AREAS.toml [PRESET]]`: rdbvh's single-threaded SAH build alone,
+//! for profilers and quick before/after checks of the builder. SCENE is a name under
+//! `../shared/scenes` (`bunny`, `sponza_crytek`) or a path to any OBJ file (or `builtin:NAME`). Prints the best thread CPU time of `REPS` builds (default
 //! 7), the tree's SAH cost, its node count and a hash of its nodes and leaf order (two builds with
 //! the same hash made the same tree), then the threaded build's best wall time on the global pool
 //! and on one thread, the single-threaded build's best wall time (the `peers` scaling is that
@@ -8,6 +9,9 @@
 //! `RDBVH_PROFILE_PAH=1` adds the `full` preset (PAH + SPFH) over the `peers` table's plane and
 //! point areas: CPU time, its ratio to the SAH build's, and the tree's hash; `plane` or `point`
 //! instead of `1` builds over that area alone (for `--toggle-collect=build_profile::pah_once`).
+//! With AREAS.toml (an area file, as `rdbvh build --areas` takes), PRESET (default `full`) is
+//! built over every triangle of the scene with each of its areas in turn, timed the same way:
+//! how to benchmark a PAH build over your own light.
 //!
 //! Under `valgrind --tool=callgrind --toggle-collect=build_profile::build_once`, only the builds
 //! (loading the triangle bounds included) are counted; `RDBVH_PROFILE_MT=0` skips the threaded
@@ -83,12 +87,47 @@ fn best_wall(reps: usize, mut f: impl FnMut() -> Bvh) -> f64 {
 
 fn main() -> ExitCode {
     let mut args = std::env::args().skip(1);
-    let Some(scene) = args.next() else {
-        eprintln!("usage: build_profile SCENE [REPS]");
+    let usage = "usage: build_profile SCENE [REPS] [AREAS.toml [PRESET]] (SCENE: a name under \
+                 ../shared/scenes, an OBJ path or builtin:NAME)";
+    let Some(scene) = args.next().filter(|s| !s.starts_with('-')) else {
+        eprintln!("{usage}");
         return ExitCode::FAILURE;
     };
-    let reps: usize = args.next().and_then(|r| r.parse().ok()).unwrap_or(7);
-    let tris = match load_scene(&scene) {
+    let reps = match args.next().map(|r| r.parse::<usize>()) {
+        None => 7,
+        Some(Ok(r)) if r > 0 => r,
+        Some(_) => {
+            eprintln!("error: REPS must be a positive number; {usage}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let own_areas = match args.next() {
+        None => None,
+        Some(file) => {
+            let preset = args.next().unwrap_or_else(|| "full".to_string());
+            let Some(preset) = Preset::from_name(&preset) else {
+                eprintln!("error: unknown preset {preset}; {usage}");
+                return ExitCode::FAILURE;
+            };
+            match rdbvh::areas::read_areas(std::path::Path::new(&file)) {
+                Ok(f) => Some((f, preset)),
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::FAILURE;
+                }
+            }
+        }
+    };
+    // A path (or a built-in scene) is opened as given; a bare name is one of ../shared's scenes.
+    let named = !scene.contains('/') && !scene.contains(':') && !scene.ends_with(".obj");
+    let loaded = if named {
+        load_scene(&scene)
+    } else {
+        rdbvh::scene::Scene::open(&scene)
+            .map(|s| s.triangles)
+            .map_err(|e| format!("cannot load {scene}: {e}"))
+    };
+    let tris = match loaded {
         Ok(t) => t,
         Err(e) => {
             eprintln!("error: {e}");
@@ -135,6 +174,34 @@ fn main() -> ExitCode {
                 "  full {name} area: {:.2} ms ({:.2}x the SAH build); tree {:016x}",
                 best_pah * 1e3,
                 best_pah / best,
+                tree_hash(&out)
+            );
+        }
+    }
+    if let Some((file, preset)) = &own_areas {
+        let options = PresetOptions::default();
+        let mut arena = BuildArena::with_capacity(n);
+        let mut out = Bvh::with_capacity(n);
+        for entry in &file.entries {
+            let mut best_area = f64::INFINITY;
+            for _ in 0..reps {
+                let t = thread_cpu_seconds();
+                arena.load_triangles(black_box(&tris)).expect("finite");
+                if let Err(e) = preset.build_into(Some(&entry.area), &options, &mut arena, &mut out)
+                {
+                    eprintln!("error: area {} (line {}): {e}", entry.index, entry.line);
+                    return ExitCode::FAILURE;
+                }
+                best_area = best_area.min(thread_cpu_seconds() - t);
+            }
+            println!(
+                "  {} area {} (line {}): {:.2} ms ({:.2}x the SAH build); nodes {}; tree {:016x}",
+                preset.name(),
+                entry.index,
+                entry.line,
+                best_area * 1e3,
+                best_area / best,
+                out.nodes().len(),
                 tree_hash(&out)
             );
         }

@@ -114,9 +114,14 @@ impl Triangle {
     ///   never hit, also when rounding makes the determinant a few ulps from zero (below
     ///   `8 eps |d| |e1| |e2|`, rays within about 1e-6 radians of the plane of a well-shaped
     ///   triangle), or so small that f32's subnormal rounding would show in the answer (triangles
-    ///   under about 1e-12 units seen along a unit direction: see `determinant_is_noise`);
+    ///   under about 1e-12 units seen along a unit direction);
     ///   every comparison rejects NaN, and the determinant and `t` must be finite, so overflow
     ///   cannot produce a hit either.
+    ///
+    /// The arithmetic is f32: `u` and `v` carry an absolute error of about 2^-24 times the
+    /// origin's distance from the triangle over the triangle's size, so a ray from far away (1e7
+    /// triangle sizes) that passes near an edge, or even beside the triangle, can be answered
+    /// either way; the README's Known limits give the numbers.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<TriangleHit> {
         let e1 = self.v1 - self.v0;

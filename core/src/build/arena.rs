@@ -110,12 +110,6 @@ pub(crate) struct PrimRefs {
 }
 
 impl PrimRefs {
-    fn with_capacity(n: usize) -> Self {
-        Self {
-            refs: Vec::with_capacity(n),
-        }
-    }
-
     fn clear(&mut self) {
         self.refs.clear();
     }
@@ -299,6 +293,10 @@ pub(crate) struct Task {
     pub measure: Option<f32>,
 }
 
+/// Pending tasks of a build: the builder descends into one child and defers the other, so they are
+/// at most one per level.
+const MAX_TASKS: usize = MAX_DEPTH as usize + 2;
+
 /// Every buffer a build uses, sized for at most `capacity` primitives when it is made. Load the
 /// primitives with [`BuildArena::load_triangles`] or [`BuildArena::push`], then hand the arena to
 /// [`super::Builder::build_into`]. One arena serves any number of builds (over many influence
@@ -319,10 +317,30 @@ pub struct BuildArena {
 }
 
 impl BuildArena {
-    /// An arena for builds over up to `capacity` primitives.
+    /// An arena for builds over up to `capacity` primitives: 32 bytes per primitive, plus about
+    /// 4.75 KiB of bins and scratch. Like `Vec::with_capacity`, it panics past `isize::MAX` bytes
+    /// and aborts when the allocation fails; [`BuildArena::try_with_capacity`] reports both.
     pub fn with_capacity(capacity: usize) -> Self {
+        Self::from_buffers(
+            Vec::with_capacity(capacity),
+            Vec::with_capacity(MAX_TASKS),
+            capacity,
+        )
+    }
+
+    /// [`BuildArena::with_capacity`], returning the allocation's failure instead of panicking or
+    /// aborting: for a host that sizes the arena from untrusted scene data.
+    pub fn try_with_capacity(capacity: usize) -> Result<Self, alloc::collections::TryReserveError> {
+        let mut refs = Vec::new();
+        refs.try_reserve_exact(capacity)?;
+        let mut tasks = Vec::new();
+        tasks.try_reserve_exact(MAX_TASKS)?;
+        Ok(Self::from_buffers(refs, tasks, capacity))
+    }
+
+    fn from_buffers(refs: Vec<PrimRef>, tasks: Vec<Task>, capacity: usize) -> Self {
         Self {
-            refs: PrimRefs::with_capacity(capacity),
+            refs: PrimRefs { refs },
             bins: [[Bin::EMPTY; MAX_BINS as usize]; 3],
             bins2: [[Bin::EMPTY; MAX_BINS as usize]; 3],
             sweep: Sweep {
@@ -330,9 +348,7 @@ impl BuildArena {
                 right: SweepSide::new(),
             },
             subsets: [Bin::EMPTY; SUBSETS],
-            // The builder descends into one child and defers the other, so pending tasks are at
-            // most one per level.
-            tasks: Vec::with_capacity(MAX_DEPTH as usize + 2),
+            tasks,
             bounds: Aabb::EMPTY,
             centroids: Aabb::EMPTY,
             capacity,
@@ -634,9 +650,27 @@ pub(crate) fn lanes_to_aabb(lo: f32x4, hi: f32x4) -> Aabb {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bvh::Bvh;
 
     /// A load that fails leaves the arena empty: a later build must not quietly run over the
     /// triangles loaded before the error.
+    #[test]
+    fn sizes_beyond_memory_are_errors_when_asked_for() {
+        assert!(BuildArena::try_with_capacity(usize::MAX / 4).is_err());
+        assert!(Bvh::try_with_capacity(usize::MAX / 4).is_err());
+        let tris = crate::test_scenes::soup(50, 3, -5.0, 5.0, 1.0);
+        let (mut arena, mut out) = (
+            BuildArena::try_with_capacity(tris.len()).unwrap(),
+            Bvh::try_with_capacity(tris.len()).unwrap(),
+        );
+        assert_eq!(arena.capacity(), tris.len());
+        arena.load_triangles(&tris).unwrap();
+        crate::build::Builder::sah()
+            .build_into(&mut arena, &mut out)
+            .unwrap();
+        assert_eq!(out, crate::build::Builder::sah().build(&tris).unwrap());
+    }
+
     #[test]
     fn a_failed_load_leaves_the_arena_empty() {
         let t = |x: f32| {

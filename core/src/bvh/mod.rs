@@ -42,13 +42,34 @@ pub struct Bvh {
 
 impl Bvh {
     /// An empty BVH with room for a build over `prims` primitives (at most `2 prims - 1` nodes), so
-    /// that [`crate::build::Builder::build_into`] does not allocate.
+    /// that [`crate::build::Builder::build_into`] does not allocate: 68 bytes per primitive (two
+    /// 32-byte nodes and a 4-byte index). Like `Vec::with_capacity`, it panics past `isize::MAX`
+    /// bytes and aborts when the allocation fails; [`Bvh::try_with_capacity`] reports both.
     pub fn with_capacity(prims: usize) -> Self {
         Self {
-            nodes: Vec::with_capacity((2 * prims).saturating_sub(1).max(1)),
+            nodes: Vec::with_capacity(Self::node_capacity(prims)),
             prim_indices: Vec::with_capacity(prims),
             max_depth: 0,
         }
+    }
+
+    /// [`Bvh::with_capacity`], returning the allocation's failure instead of panicking or
+    /// aborting.
+    pub fn try_with_capacity(prims: usize) -> Result<Self, alloc::collections::TryReserveError> {
+        let mut nodes = Vec::new();
+        nodes.try_reserve_exact(Self::node_capacity(prims))?;
+        let mut prim_indices = Vec::new();
+        prim_indices.try_reserve_exact(prims)?;
+        Ok(Self {
+            nodes,
+            prim_indices,
+            max_depth: 0,
+        })
+    }
+
+    /// Nodes of a build over `prims` primitives, at most: `2 prims - 1` (at least one).
+    fn node_capacity(prims: usize) -> usize {
+        prims.saturating_mul(2).saturating_sub(1).max(1)
     }
 
     /// Nodes, root first, children adjacent; an empty BVH has no nodes.

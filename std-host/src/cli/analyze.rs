@@ -52,11 +52,11 @@ pub struct AnalyzeArgs {
     #[arg(long, value_name = "NAME", default_value = "full")]
     pub preset: String,
     /// Rays traced per area for the measured costs (default: the file's
-    /// [settings].rays_per_config, else 1000).
+    /// `[settings]` rays_per_config, else 1000).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub rays: Option<u32>,
     /// The thesis's builder, constants, fallback and ray sampler (as `experiment --thesis-mode`,
-    /// with the builder keys of the file's [settings] when it has them, as an experiment file
+    /// with the builder keys of the file's `[settings]` when it has them, as an experiment file
     /// does).
     #[arg(long)]
     pub thesis_mode: bool,

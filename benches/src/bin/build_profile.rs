@@ -1,7 +1,7 @@
 //! `build_profile SCENE [REPS] [AREAS.toml [PRESET]]`: rdbvh's single-threaded SAH build alone,
 //! for profilers and quick before/after checks of the builder. SCENE is a name under
-//! `../shared/scenes` (`bunny`, `sponza_crytek`) or a path to any OBJ file (or `builtin:NAME`). Prints the best thread CPU time of `REPS` builds (default
-//! 7), the tree's SAH cost, its node count and a hash of its nodes and leaf order (two builds with
+//! `../shared/scenes` (`bunny`, `sponza_crytek`) or a path to any OBJ file (or `builtin:NAME`).
+//! Prints the best thread CPU time of `REPS` builds (default 7), the tree's SAH cost, its node count and a hash of its nodes and leaf order (two builds with
 //! the same hash made the same tree), then the threaded build's best wall time on the global pool
 //! and on one thread, the single-threaded build's best wall time (the `peers` scaling is that
 //! over the threaded build's) and whether the threaded tree equals the single-threaded one.
@@ -24,7 +24,7 @@ use std::time::Instant;
 
 use rdbvh_benches::compare::{plane_area_over, point_area_over};
 use rdbvh_benches::{load_scene, thread_cpu_seconds};
-use rdbvh_core::build::{BuildArena, Builder, Preset, PresetOptions};
+use rdbvh_core::build::{BuildArena, Builder, Preset, PresetError, PresetOptions};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::heuristics::{CostConstants, Sah};
@@ -42,13 +42,19 @@ fn build_mt_once(tris: &[Triangle]) -> Bvh {
     rdbvh::parallel::build(&Builder::sah(), black_box(tris)).expect("finite scene")
 }
 
-/// One timed `full` build over `area`: loading the bounds and the preset's build.
+/// One timed build of `preset` over `area`: loading the bounds and the preset's build.
 #[inline(never)]
-fn pah_once(tris: &[Triangle], area: &InfluenceArea, arena: &mut BuildArena, out: &mut Bvh) {
+fn pah_once(
+    tris: &[Triangle],
+    preset: Preset,
+    area: &InfluenceArea,
+    arena: &mut BuildArena,
+    out: &mut Bvh,
+) -> Result<(), PresetError> {
     arena.load_triangles(black_box(tris)).expect("finite");
-    Preset::Full
+    preset
         .build_into(Some(area), &PresetOptions::default(), arena, out)
-        .expect("pah build");
+        .map(|_| ())
 }
 
 fn tree_hash(bvh: &Bvh) -> u64 {
@@ -167,7 +173,7 @@ fn main() -> ExitCode {
             let mut best_pah = f64::INFINITY;
             for _ in 0..reps {
                 let t = thread_cpu_seconds();
-                pah_once(&tris, area, &mut arena, &mut out);
+                pah_once(&tris, Preset::Full, area, &mut arena, &mut out).expect("pah build");
                 best_pah = best_pah.min(thread_cpu_seconds() - t);
             }
             println!(
@@ -179,16 +185,13 @@ fn main() -> ExitCode {
         }
     }
     if let Some((file, preset)) = &own_areas {
-        let options = PresetOptions::default();
         let mut arena = BuildArena::with_capacity(n);
         let mut out = Bvh::with_capacity(n);
         for entry in &file.entries {
             let mut best_area = f64::INFINITY;
             for _ in 0..reps {
                 let t = thread_cpu_seconds();
-                arena.load_triangles(black_box(&tris)).expect("finite");
-                if let Err(e) = preset.build_into(Some(&entry.area), &options, &mut arena, &mut out)
-                {
+                if let Err(e) = pah_once(&tris, *preset, &entry.area, &mut arena, &mut out) {
                     eprintln!("error: area {} (line {}): {e}", entry.index, entry.line);
                     return ExitCode::FAILURE;
                 }

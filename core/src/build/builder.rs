@@ -281,7 +281,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
     /// node as before (a node's split depends on its primitives alone), so
     /// [`WideBvh::from_binary`] of its tree has the same nodes as that of this builder's tree, with
     /// the same triangles in each leaf (a leaf of two blocks may group them otherwise). It skips
-    /// the nodes below: 43% of the bunny's binary nodes and 40% of Crytek Sponza's, 19-22% of the
+    /// the nodes below: 43% of the bunny's binary nodes and 40% of Crytek Sponza's, 18-22% of the
     /// build's instructions.
     ///
     /// [`crate::build::reinsert`] on the smaller tree can only move its four-triangle leaves as

@@ -202,10 +202,9 @@ impl Chart for Lines<'_> {
         }
         let mut chart = b.build_cartesian_2d(x0..x1, 0f64..ymax).map_err(e)?;
         let mut mesh = chart.configure_mesh();
-        // Whole-number x values (levels, area counts) read as integers, not `1.0, 2.0`.
-        let whole = pts().all(|p| p.0.fract() == 0.0);
+        // Whole-number ticks (levels, area counts) read as integers, not `1.0, 2.0`.
         let x_fmt = |x: &f64| {
-            if whole {
+            if x.fract() == 0.0 {
                 format!("{x:.0}")
             } else {
                 format!("{x}")

@@ -1,4 +1,4 @@
-//! Build time of the five presets (issue 3) on the bunny and Crytek Sponza, throughput in
+//! Build time of the six presets (issue 3) on the bunny and Crytek Sponza, throughput in
 //! triangles: `presets/SCENE/{sah,standard}` (no area: these presets ignore it) and
 //! `presets/SCENE/{facing,longest,full}-{plane,point}` with a plane area (light rectangle just
 //! outside the scene's box, normal tilted about 13 degrees from straight down, covering the box)

@@ -637,7 +637,7 @@ fn presets_without_areas() {
     std::fs::write(&rays, "ox,oy,oz,dx,dy,dz\n5,5,5,0,1,0\n").unwrap();
     let hits = dir.join("hits.csv");
     let (rays, hits) = (rays.to_str().unwrap(), hits.to_str().unwrap());
-    for preset in ["facing", "longest", "full"] {
+    for preset in ["facing", "longest", "full", "pah"] {
         let args = ["build", "builtin:room", "--preset", preset];
         assert_one_line_error(&rdbvh(&args), 2, &[preset, "--areas"], &args);
         let args = [
@@ -786,11 +786,11 @@ fn area_and_option_errors_are_one_line() {
             vec!["--preset"],
         ),
         (
-            ["build", "builtin:room", "--preset", "pah"]
+            ["build", "builtin:room", "--preset", "pha"]
                 .map(String::from)
                 .to_vec(),
             2,
-            vec!["--preset", "full"],
+            vec!["--preset", "full", "pah"],
         ),
         (
             {

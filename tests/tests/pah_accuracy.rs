@@ -158,3 +158,70 @@ fn perspective_pah_holds_at_130_degrees_for_both_measures() {
         assert!(error < 0.03, "{measure:?}: {estimate} vs {measured}");
     }
 }
+
+/// The `pah` preset (PAH over all three axes) against the thesis's `full` (PAH + SPFH) on every
+/// thesis configuration with a scene: by the PAH estimate (exact for the tree) and by the
+/// measured all-hit cost of the same 20,000 rays, `pah` is never costlier than `full` by more
+/// than a rounding margin, and cheaper on the whole. Pricing every axis is what makes it so;
+/// SPFH trusts the facing axis to save sweeps.
+#[test]
+fn pah_preset_costs_no_more_than_full_on_every_thesis_configuration() {
+    let Some(shared) = require_shared() else {
+        return;
+    };
+    let file = read_areas(&shared.join("thesis/experiments.toml")).unwrap();
+    let mut scenes: std::collections::HashMap<String, Scene> = Default::default();
+    let o = PresetOptions::default();
+    let (mut log_estimates, mut log_measured, mut checked) = (0.0f64, 0.0f64, 0);
+    for entry in &file.entries {
+        let Some(name) = entry.file.as_deref() else {
+            continue;
+        };
+        let path = shared.join("scenes/thesis").join(name);
+        if !path.exists() {
+            continue;
+        }
+        let scene = scenes
+            .entry(name.to_string())
+            .or_insert_with(|| Scene::load(&path).unwrap());
+        let tris = &scene.triangles;
+        let pah = AreaPah::new(&entry.area, o.perspective);
+        let [full, all_axes] = [Preset::Full, Preset::Pah].map(|preset| {
+            let bvh = local_bvh(tris, &entry.area, preset, &o);
+            let estimate = bvh.estimated_cost_over(&pah, o.constants, pah.window_measure());
+            let mut rays =
+                RaySampler::new(entry.area, 7).distribution(PointDistribution::SolidAngle);
+            let measured = (0..20_000)
+                .map(|_| f64::from(bvh.all_hit(&rays.sample(), tris).cost(o.constants)))
+                .sum::<f64>()
+                / 20_000.0;
+            (f64::from(estimate), measured)
+        });
+        let test = entry.thesis_test.as_deref().unwrap_or("?");
+        println!(
+            "{test}: pah {:.3} / full {:.3} estimated, {:.3} / {:.3} measured",
+            all_axes.0, full.0, all_axes.1, full.1
+        );
+        assert!(
+            all_axes.0 <= full.0 * 1.001,
+            "{test}: estimates {all_axes:?} vs {full:?}"
+        );
+        assert!(
+            all_axes.1 <= full.1 * 1.01,
+            "{test}: measured {all_axes:?} vs {full:?}"
+        );
+        log_estimates += (all_axes.0 / full.0).ln();
+        log_measured += (all_axes.1 / full.1).ln();
+        checked += 1;
+    }
+    assert!(checked >= 40, "only {checked} configurations had scenes");
+    let (estimated, measured) = (
+        (log_estimates / f64::from(checked)).exp(),
+        (log_measured / f64::from(checked)).exp(),
+    );
+    println!("{checked} configurations: pah / full geometric mean {estimated:.3} estimated, {measured:.3} measured");
+    assert!(
+        estimated < 0.95 && measured < 0.95,
+        "{estimated}, {measured}"
+    );
+}

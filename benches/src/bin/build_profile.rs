@@ -6,9 +6,11 @@
 //! and on one thread, the single-threaded build's best wall time (the `peers` scaling is that
 //! over the threaded build's) and whether the threaded tree equals the single-threaded one.
 //!
-//! `RDBVH_PROFILE_PAH=1` adds the `full` preset (PAH + SPFH) over the `peers` table's plane and
-//! point areas: CPU time, its ratio to the SAH build's, and the tree's hash; `plane` or `point`
-//! instead of `1` builds over that area alone (for `--toggle-collect=build_profile::pah_once`).
+//! `RDBVH_PROFILE_PAH=1` adds the `full` (PAH + SPFH) and `pah` (PAH over all axes) presets over
+//! the `peers` table's plane and point areas: CPU time, its ratio to the SAH build's, and the
+//! tree's hash; `plane` or `point` instead of `1` builds over that area alone, and
+//! `RDBVH_PROFILE_PRESET=full` (or `pah`) that preset alone (for
+//! `--toggle-collect=build_profile::pah_once`).
 //! With AREAS.toml (an area file, as `rdbvh build --areas` takes), PRESET (default `full`) is
 //! built over every triangle of the scene with each of its areas in turn, timed the same way:
 //! how to benchmark a PAH build over your own light.
@@ -157,8 +159,13 @@ fn main() -> ExitCode {
         n as f64 / best * 1e-6,
         bvh.nodes().len()
     );
-    // PAH: the `full` preset (PAH + SPFH) with the plane and point areas the `peers` table uses.
+    // PAH: the `full` (PAH + SPFH) and `pah` presets with the plane and point areas the `peers`
+    // table uses.
     let pah = std::env::var("RDBVH_PROFILE_PAH").unwrap_or_default();
+    let only = std::env::var("RDBVH_PROFILE_PRESET").ok();
+    let presets = [Preset::Full, Preset::Pah]
+        .into_iter()
+        .filter(|p| only.as_deref().is_none_or(|o| o == p.name()));
     if ["1", "plane", "point"].contains(&pah.as_str()) {
         let b = tris.iter().fold(rdbvh_core::geometry::Aabb::EMPTY, |b, t| {
             b.union(t.bounds())
@@ -167,17 +174,18 @@ fn main() -> ExitCode {
             ("plane", plane_area_over(&b).expect("plane").into()),
             ("point", point_area_over(&b).expect("point").into()),
         ];
-        for (name, area) in areas.iter().filter(|(name, _)| pah == "1" || pah == *name) {
+        let areas = areas.iter().filter(|(name, _)| pah == "1" || pah == *name);
+        for ((name, area), preset) in areas.flat_map(|a| presets.clone().map(move |p| (a, p))) {
             let mut arena = BuildArena::with_capacity(n);
             let mut out = Bvh::with_capacity(n);
             let mut best_pah = f64::INFINITY;
             for _ in 0..reps {
                 let t = thread_cpu_seconds();
-                pah_once(&tris, Preset::Full, area, &mut arena, &mut out).expect("pah build");
+                pah_once(&tris, preset, area, &mut arena, &mut out).expect("pah build");
                 best_pah = best_pah.min(thread_cpu_seconds() - t);
             }
             println!(
-                "  full {name} area: {:.2} ms ({:.2}x the SAH build); tree {:016x}",
+                "  {preset} {name} area: {:.2} ms ({:.2}x the SAH build); tree {:016x}",
                 best_pah * 1e3,
                 best_pah / best,
                 tree_hash(&out)

@@ -48,7 +48,7 @@ pub struct AnalyzeArgs {
     /// Influence areas (TOML): one build and analysis per area that applies to the scene.
     #[arg(long, value_name = "AREAS.toml")]
     pub areas: PathBuf,
-    /// The local BVH's preset: full, longest, facing, standard or sah.
+    /// The local BVH's preset: full, longest, facing, standard, sah or pah.
     #[arg(long, value_name = "NAME", default_value = "full")]
     pub preset: String,
     /// Rays traced per area for the measured costs (default: the file's
@@ -322,7 +322,7 @@ fn write_nodes(
 pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
     let preset = Preset::from_name(&args.preset).ok_or_else(|| {
         CliError::Usage(format!(
-            "unknown preset `{}` (expected full, longest, facing, standard or sah)",
+            "unknown preset `{}` (expected full, longest, facing, standard, sah or pah)",
             args.preset
         ))
     })?;

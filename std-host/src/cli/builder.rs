@@ -36,7 +36,7 @@ impl BuilderKind {
     }
 }
 
-/// A preset name on the command line: `sah`, `standard`, `facing`, `longest` or `full`.
+/// A preset name on the command line: `sah`, `standard`, `facing`, `longest`, `full` or `pah`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PresetArg(pub Preset);
 
@@ -48,6 +48,7 @@ impl ValueEnum for PresetArg {
             PresetArg(Preset::Facing),
             PresetArg(Preset::Longest),
             PresetArg(Preset::Full),
+            PresetArg(Preset::Pah),
         ]
     }
 
@@ -58,6 +59,7 @@ impl ValueEnum for PresetArg {
             Preset::Facing => "SAH + splitting plane facing (SPFH); needs --areas",
             Preset::Longest => "PAH + LSPH; needs --areas",
             Preset::Full => "PAH + SPFH, the thesis's full method; needs --areas",
+            Preset::Pah => "PAH with sah's builder (all three axes priced); needs --areas",
         };
         Some(PossibleValue::new(self.0.name()).help(help))
     }
@@ -66,7 +68,7 @@ impl ValueEnum for PresetArg {
 /// The name of the axis chooser a preset uses, as the `builder` report key spells it.
 pub fn chooser_name(preset: Preset) -> &'static str {
     match preset {
-        Preset::Sah => "sah",
+        Preset::Sah | Preset::Pah => "sah",
         Preset::Standard | Preset::Longest => "lsph",
         Preset::Facing | Preset::Full => "spfh",
     }

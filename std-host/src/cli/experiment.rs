@@ -42,7 +42,7 @@ pub struct ExperimentArgs {
     /// Rays per run (overrides rays_per_config).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub rays: Option<u32>,
-    /// Heuristics to run, comma-separated: full, longest, facing, standard, sah (overrides
+    /// Heuristics to run, comma-separated: full, longest, facing, standard, sah, pah (overrides
     /// heuristics).
     #[arg(long, value_name = "a,b", value_delimiter = ',')]
     pub presets: Option<Vec<String>>,

@@ -196,7 +196,7 @@ pub fn parse_presets<'a>(
         let name = name.trim();
         let p = Preset::from_name(name).ok_or_else(|| {
             ExperimentError::Settings(format!(
-                "unknown heuristic `{name}` (expected full, longest, facing, standard or sah)"
+                "unknown heuristic `{name}` (expected full, longest, facing, standard, sah or pah)"
             ))
         })?;
         if !out.contains(&p) {

@@ -106,6 +106,12 @@ impl PahOrtho {
         f32x4::splat(w.x) * ey * ez + f32x4::splat(w.y) * ex * ez + f32x4::splat(w.z) * ex * ey
     }
 
+    /// [`CostModel::measure4`] as a call, for the sweeps of nodes that straddle the window.
+    #[inline(never)]
+    fn measure4_out_of_line(&self, b: &Aabb4) -> f32x4 {
+        self.measure4(b)
+    }
+
     /// The lower and upper corners, in window coordinates, of the projection of `b`: along each
     /// window axis the projection spans the centre's coordinate +- the sum of `|axis_k| e_k / 2`.
     #[inline]
@@ -209,10 +215,13 @@ impl CostModel for PahOrtho {
     }
 
     /// With the whole node inside the window, the closed form alone (zero for empty lanes).
+    /// Otherwise the window test, out of line: inlined, its code sat in every sweep loop and
+    /// cost the hinted sweeps (most of a build's) 7% more instructions than SAH's, although only
+    /// the few nodes straddling the window's border take it.
     #[inline(always)]
     fn measure4_hinted(&self, b: &Aabb4, hint: u32) -> f32x4 {
         if hint == 0 {
-            return self.measure4(b);
+            return self.measure4_out_of_line(b);
         }
         self.projected_area4(b)
     }

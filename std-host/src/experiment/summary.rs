@@ -28,7 +28,7 @@ pub struct RunKey {
     pub kind: String,
     /// `Parallel`, `15`, `45`, `Oblique`.
     pub orientation: String,
-    /// `Full`, `Longest`, `Facing`, `Standard` (or `Sah`).
+    /// `Full`, `Longest`, `Facing`, `Standard` (or `Sah`, `Pah`).
     pub heuristic: String,
 }
 
@@ -47,6 +47,9 @@ pub struct Findings {
     pub spfh_over_lsph: PerGroup,
     /// Mean over scenes of `full / longest` (SPFH vs LSPH, both with PAH).
     pub spfh_over_lsph_pah: PerGroup,
+    /// Mean over scenes of `pah / full` (PAH over all axes vs the thesis's PAH + SPFH), where
+    /// both ran (`pah` is not among the default heuristics).
+    pub pah_over_full: PerGroup,
     /// For the `full` preset: summed real cost with fallback over summed fallback-BVH-alone cost.
     pub structure_over_fallback: PerGroup,
     /// The same with closest-hit costs (this project's columns only).
@@ -171,6 +174,7 @@ pub fn findings(table: &Table, keys: &[RunKey]) -> Findings {
         };
         out.spfh_over_lsph[g] = mean(&ratio("Facing", "Standard", "Real cost without fallback"));
         out.spfh_over_lsph_pah[g] = mean(&ratio("Full", "Longest", "Real cost without fallback"));
+        out.pah_over_full[g] = mean(&ratio("Pah", "Full", "Real cost without fallback"));
         let sums = |a: &str, b: &str| -> Option<f64> {
             let (mut x, mut y, mut n) = (0.0, 0.0, 0);
             for k in in_group.iter().filter(|k| k.heuristic == "Full") {
@@ -234,6 +238,7 @@ mod tests {
             );
         };
         let (f, s, full) = (key("A", "Facing"), key("A", "Standard"), key("A", "Full"));
+        let pah = key("A", "Pah");
         put(
             &mut t,
             &f,
@@ -255,9 +260,14 @@ mod tests {
         put(
             &mut t,
             &full,
-            &[("Real cost with fallback", 3.0), ("Fallback BVH cost", 4.0)],
+            &[
+                ("Real cost with fallback", 3.0),
+                ("Fallback BVH cost", 4.0),
+                ("Real cost without fallback", 5.0),
+            ],
         );
-        let r = findings(&t, &[f, s, full]);
+        put(&mut t, &pah, &[("Real cost without fallback", 4.5)]);
+        let r = findings(&t, &[f, s, full.clone()]);
         // PAH errors 1/8 and 0 -> 1/16; SAH errors 4/8 and 5/10 -> 0.5.
         assert!((r.pah_error[0].unwrap() - 0.0625).abs() < 1e-12);
         assert!((r.sah_error[0].unwrap() - 0.5).abs() < 1e-12);
@@ -265,6 +275,10 @@ mod tests {
         assert!((r.structure_over_fallback[0].unwrap() - 0.75).abs() < 1e-12);
         assert_eq!(r.pah_error[1], None);
         assert_eq!(cheaper_groups(&r.structure_over_fallback), (1, 1));
+        // No `pah` run among the keys, no ratio; with one, pah / full.
+        assert_eq!(r.pah_over_full[0], None);
+        let r = findings(&t, &[full, pah]);
+        assert!((r.pah_over_full[0].unwrap() - 0.9).abs() < 1e-12);
         // A run spelt with a doubled underscore finds the single-underscore row.
         let mut doubled = key("A", "Facing");
         doubled.name = "A__Plane_Parallel_Facing".into();

@@ -7,9 +7,10 @@
 //! ray's index in the output.
 
 use std::fmt;
-use std::fs::File;
 use std::io::Read;
 use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
 
 use rdbvh_core::geometry::Ray;
 use rdbvh_core::Vec3;
@@ -43,16 +44,88 @@ impl std::error::Error for RaysError {}
 
 /// Reads every ray of the CSV file at `path`.
 pub fn read_rays(path: &Path) -> Result<Vec<Ray>, RaysError> {
-    let file = File::open(path).map_err(|e| RaysError {
+    let text = std::fs::read(path).map_err(|e| RaysError {
         path: path.to_path_buf(),
         line: None,
         reason: format!("cannot open: {e}"),
     })?;
-    parse_rays(file, path)
+    parse_text(&text, path, PIECE_BYTES)
 }
 
 /// Reads every ray of CSV text from `reader`; `label` names it in errors.
-pub fn parse_rays(reader: impl Read, label: &Path) -> Result<Vec<Ray>, RaysError> {
+///
+/// The text is read whole, then parsed on every thread when it can be cut at line feeds without
+/// changing what a row is: when it holds no quote (a quoted cell may hold a line end) and is over
+/// 2 MiB. Each piece goes through the same CSV reader and the same checks, and the first error
+/// in the file is reported with the line and ray index the one-thread read gives (a test holds
+/// the two to the same rays and errors). Other text is read on one thread.
+pub fn parse_rays(mut reader: impl Read, label: &Path) -> Result<Vec<Ray>, RaysError> {
+    let mut text = Vec::new();
+    reader.read_to_end(&mut text).map_err(|e| RaysError {
+        path: label.to_path_buf(),
+        line: None,
+        reason: format!("cannot read: {e}"),
+    })?;
+    parse_text(&text, label, PIECE_BYTES)
+}
+
+/// Text below this many bytes per piece is not worth a thread: pieces are at least this long.
+const PIECE_BYTES: usize = 1 << 20;
+
+/// Where a rays file keeps each value.
+struct Columns {
+    /// The header's field count: every row must have as many.
+    fields: usize,
+    /// `ox, oy, oz, dx, dy, dz`.
+    required: [usize; 6],
+    tmin: Option<usize>,
+    tmax: Option<usize>,
+}
+
+/// A bad row: the offset in the text where it starts (when known), the 0-based index of its
+/// ray, and what is wrong (about that ray when `of_ray`, prefixed `ray N: ` once the index is
+/// final).
+struct RowError {
+    at: Option<u64>,
+    ray: usize,
+    of_ray: bool,
+    reason: String,
+}
+
+impl RowError {
+    fn into_error(self, text: &[u8], label: &Path) -> RaysError {
+        let reason = if self.of_ray {
+            format!("ray {}: {}", self.ray, self.reason)
+        } else {
+            self.reason
+        };
+        RaysError {
+            path: label.to_path_buf(),
+            line: self.at.map(|at| line_at(text, at)),
+            reason,
+        }
+    }
+}
+
+/// The 1-based line of the row the CSV reader places at byte `at`: one more than the line ends
+/// (LF, CRLF or a lone CR, as the reader takes them) before its first byte. The reader's own line
+/// count is not used: after a CRLF it places the next row at the line feed and counts one line
+/// too few (a row on line 3 of a CRLF file was reported on line 2), so line-end bytes at `at`
+/// are skipped first.
+fn line_at(text: &[u8], at: u64) -> u64 {
+    let mut at = usize::try_from(at).unwrap_or(usize::MAX).min(text.len());
+    while matches!(text.get(at), Some(b'\r' | b'\n')) {
+        at += 1;
+    }
+    let before = &text[..at];
+    let feeds = before.iter().filter(|&&b| b == b'\n').count();
+    let lone_cr = |w: &[u8]| w[0] == b'\r' && w.get(1).is_none_or(|&b| b != b'\n');
+    let returns = before.windows(2).filter(|w| lone_cr(w)).count()
+        + usize::from(before.last() == Some(&b'\r'));
+    1 + (feeds + returns) as u64
+}
+
+fn parse_text(text: &[u8], label: &Path, piece: usize) -> Result<Vec<Ray>, RaysError> {
     let error = |line: Option<u64>, reason: String| RaysError {
         path: label.to_path_buf(),
         line,
@@ -63,11 +136,16 @@ pub fn parse_rays(reader: impl Read, label: &Path) -> Result<Vec<Ray>, RaysError
     let mut csv = csv::ReaderBuilder::new()
         .has_headers(true)
         .trim(csv::Trim::Headers)
-        .from_reader(reader);
+        .from_reader(text);
     let header = csv
         .headers()
-        .map_err(|e| error(Some(1), csv_reason(&e)))?
+        .map_err(|e| {
+            let at = e.position().map_or(0, |p| p.byte());
+            error(Some(line_at(text, at)), csv_reason(&e))
+        })?
         .clone();
+    // Blank lines before the header are skipped, so it need not be on line 1.
+    let header_line = Some(line_at(text, header.position().map_or(0, |p| p.byte())));
     if header.iter().all(str::is_empty) {
         return Err(error(
             None,
@@ -84,7 +162,7 @@ pub fn parse_rays(reader: impl Read, label: &Path) -> Result<Vec<Ray>, RaysError
             .filter(|(_, h)| h.eq_ignore_ascii_case(name));
         let first = found.next().map(|(i, _)| i);
         if found.next().is_some() {
-            return Err(error(Some(1), format!("column '{name}' appears twice")));
+            return Err(error(header_line, format!("column '{name}' appears twice")));
         }
         Ok(first)
     };
@@ -92,7 +170,7 @@ pub fn parse_rays(reader: impl Read, label: &Path) -> Result<Vec<Ray>, RaysError
     for (slot, name) in required.iter_mut().zip(REQUIRED_COLUMNS) {
         *slot = column(name)?.ok_or_else(|| {
             error(
-                Some(1),
+                header_line,
                 format!(
                     "missing column '{name}' (the header must name {}, optionally tmin,tmax)",
                     REQUIRED_COLUMNS.join(",")
@@ -100,61 +178,147 @@ pub fn parse_rays(reader: impl Read, label: &Path) -> Result<Vec<Ray>, RaysError
             )
         })?;
     }
-    let tmin = column(OPTIONAL_COLUMNS[0])?;
-    let tmax = column(OPTIONAL_COLUMNS[1])?;
-
-    let mut rays = Vec::new();
-    let mut record = csv::StringRecord::new();
-    loop {
-        match csv.read_record(&mut record) {
-            Ok(false) => break,
-            Ok(true) => {}
-            Err(e) => {
-                let line = e.position().map(|p| p.line());
-                return Err(error(line, csv_reason(&e)));
-            }
+    let columns = Columns {
+        fields: header.len(),
+        required,
+        tmin: column(OPTIONAL_COLUMNS[0])?,
+        tmax: column(OPTIONAL_COLUMNS[1])?,
+    };
+    // Where the reader stands after the header (past any blank lines before it and its line end).
+    let body = usize::try_from(csv.position().byte()).unwrap_or(usize::MAX);
+    let pieces = match pieces(text, body, piece) {
+        Some(p) if p.len() > 1 => p,
+        _ => {
+            // One thread: the header's reader reads on.
+            let mut rays = Vec::new();
+            read_rows(&mut csv, &columns, 0, &mut rays).map_err(|e| e.into_error(text, label))?;
+            return Ok(rays);
         }
-        let line = record.position().map(|p| p.line());
-        let ray_index = rays.len();
-        let field = |i: usize, name: &str| -> Result<Option<f32>, RaysError> {
-            let text = record.get(i).unwrap_or("").trim();
-            if text.is_empty() {
-                return Ok(None);
-            }
-            text.parse::<f32>().map(Some).map_err(|_| {
-                // Echoed escaped and cut short: a quoted cell may hold newlines or a whole file.
-                let shown: String = text.chars().take(40).collect();
-                let more = if text.chars().count() > 40 { "..." } else { "" };
-                error(
-                    line,
-                    format!(
-                        "ray {ray_index}: column '{name}': cannot parse '{}{more}' as a number",
-                        shown.escape_debug()
-                    ),
-                )
-            })
-        };
-        let mut v = [0.0f32; 6];
-        for ((value, &i), name) in v.iter_mut().zip(&required).zip(REQUIRED_COLUMNS) {
-            *value = field(i, name)?
-                .ok_or_else(|| error(line, format!("ray {ray_index}: column '{name}' is empty")))?;
+    };
+    let mut parsed: Vec<(Vec<Ray>, Option<RowError>)> = pieces
+        .par_iter()
+        .map(|&(start, end)| {
+            let mut csv = csv::ReaderBuilder::new()
+                .has_headers(false)
+                .flexible(true)
+                .from_reader(&text[start..end]);
+            // A row per line at most: sized once instead of grown by copies.
+            let mut rays = Vec::new();
+            let failed = read_rows(&mut csv, &columns, start as u64, &mut rays).err();
+            (rays, failed)
+        })
+        .collect();
+    // Every piece before the first failed one was read whole, so its rays are the ones before.
+    if let Some(k) = parsed.iter().position(|(_, failed)| failed.is_some()) {
+        let before: usize = parsed[..k].iter().map(|(rays, _)| rays.len()).sum();
+        if let (_, Some(mut e)) = parsed.swap_remove(k) {
+            e.ray += before;
+            return Err(e.into_error(text, label));
         }
-        // An empty tmin/tmax cell means the default, like a missing column.
-        let t_min = match tmin {
-            Some(i) => field(i, "tmin")?.unwrap_or(0.0),
-            None => 0.0,
-        };
-        let t_max = match tmax {
-            Some(i) => field(i, "tmax")?.unwrap_or(f32::INFINITY),
-            None => f32::INFINITY,
-        };
-        let origin = Vec3::new(v[0], v[1], v[2]);
-        let dir = Vec3::new(v[3], v[4], v[5]);
-        let ray = Ray::segment(origin, dir, t_min, t_max)
-            .map_err(|e| error(line, format!("ray {ray_index}: {e}")))?;
-        rays.push(ray);
+    }
+    let mut rays = Vec::with_capacity(parsed.iter().map(|(rays, _)| rays.len()).sum());
+    for (piece, _) in parsed {
+        rays.extend(piece);
     }
     Ok(rays)
+}
+
+/// The body of `text` (from byte `body`) cut at line ends into pieces of at least `piece` bytes,
+/// one or more per thread, as byte ranges; `None` when the text cannot be cut (see
+/// [`parse_rays`]).
+fn pieces(text: &[u8], body: usize, piece: usize) -> Option<Vec<(usize, usize)>> {
+    if body >= text.len() || text.len() - body < 2 * piece || text.contains(&b'"') {
+        return None;
+    }
+    let wanted = (rayon::current_num_threads() * 4).max(1);
+    let size = ((text.len() - body) / wanted).max(piece);
+    let mut cuts = vec![body];
+    while let Some(&last) = cuts.last().filter(|&&c| c < text.len()) {
+        let from = (last + size).min(text.len());
+        let next = text[from..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map_or(text.len(), |i| from + i + 1);
+        cuts.push(next);
+    }
+    Some(cuts.windows(2).map(|w| (w[0], w[1])).collect())
+}
+
+/// Reads the rows of `csv`, whose text starts at byte `offset` of the file, into `rays`. A
+/// flexible reader's rows are held to the header's field count here, with the message the strict
+/// reader gives.
+fn read_rows<R: Read>(
+    csv: &mut csv::Reader<R>,
+    columns: &Columns,
+    offset: u64,
+    rays: &mut Vec<Ray>,
+) -> Result<(), RowError> {
+    let mut bytes = csv::ByteRecord::new();
+    let fail = |at: Option<u64>, ray: usize, of_ray: bool, reason: String| RowError {
+        at: at.map(|b| b + offset),
+        ray,
+        of_ray,
+        reason,
+    };
+    loop {
+        match csv.read_byte_record(&mut bytes) {
+            Ok(false) => return Ok(()),
+            Ok(true) => {}
+            Err(e) => {
+                let at = e.position().map(|p| p.byte());
+                return Err(fail(at, rays.len(), false, csv_reason(&e)));
+            }
+        }
+        let at = bytes.position().map(|p| p.byte());
+        if bytes.len() != columns.fields {
+            let reason = format!(
+                "has {} fields, but the header has {}",
+                bytes.len(),
+                columns.fields
+            );
+            return Err(fail(at, rays.len(), false, reason));
+        }
+        let record = csv::StringRecord::from_byte_record(bytes)
+            .map_err(|_| fail(at, rays.len(), false, "not valid UTF-8".to_string()))?;
+        let ray = ray_of(&record, columns).map_err(|reason| fail(at, rays.len(), true, reason))?;
+        rays.push(ray);
+        bytes = record.into_byte_record();
+    }
+}
+
+/// The ray of one row, or what is wrong with it.
+fn ray_of(record: &csv::StringRecord, columns: &Columns) -> Result<Ray, String> {
+    let field = |i: usize, name: &str| -> Result<Option<f32>, String> {
+        let text = record.get(i).unwrap_or("").trim();
+        if text.is_empty() {
+            return Ok(None);
+        }
+        text.parse::<f32>().map(Some).map_err(|_| {
+            // Echoed escaped and cut short: a quoted cell may hold newlines or a whole file.
+            let shown: String = text.chars().take(40).collect();
+            let more = if text.chars().count() > 40 { "..." } else { "" };
+            format!(
+                "column '{name}': cannot parse '{}{more}' as a number",
+                shown.escape_debug()
+            )
+        })
+    };
+    let mut v = [0.0f32; 6];
+    for ((value, &i), name) in v.iter_mut().zip(&columns.required).zip(REQUIRED_COLUMNS) {
+        *value = field(i, name)?.ok_or_else(|| format!("column '{name}' is empty"))?;
+    }
+    // An empty tmin/tmax cell means the default, like a missing column.
+    let t_min = match columns.tmin {
+        Some(i) => field(i, "tmin")?.unwrap_or(0.0),
+        None => 0.0,
+    };
+    let t_max = match columns.tmax {
+        Some(i) => field(i, "tmax")?.unwrap_or(f32::INFINITY),
+        None => f32::INFINITY,
+    };
+    let origin = Vec3::new(v[0], v[1], v[2]);
+    let dir = Vec3::new(v[3], v[4], v[5]);
+    Ray::segment(origin, dir, t_min, t_max).map_err(|e| e.to_string())
 }
 
 /// A CSV error without the crate's own position prefix (ours names the line).
@@ -250,6 +414,25 @@ mod tests {
         }
     }
 
+    /// Lines are counted by their ends, LF, CRLF or lone CR: the CSV reader's own count lost one
+    /// per CRLF, and a header after blank lines is not on line 1.
+    #[test]
+    fn lines_are_counted_with_crlf_and_blank_lines() {
+        assert_eq!(
+            line_of("ox,oy,oz,dx,dy,dz\r\n1,2,3,0,0,1\r\n0,0,0,0,0,0\r\n"),
+            Some(3)
+        );
+        assert_eq!(
+            line_of("ox,oy,oz,dx,dy,dz\r\n\r\n1,2,3,0,0,1\r\n\n\r\n0,0,0,1,0\r\n"),
+            Some(6)
+        );
+        assert_eq!(line_of("\n\r\nox,oy,oz,dx,dy\n0,0,0,1,0\n"), Some(3));
+        assert_eq!(
+            line_of("ox,oy,oz,dx,dy,dz\r1,2,3,0,0,1\r\r\n0,0,0,0,0,0\r"),
+            Some(4)
+        );
+    }
+
     /// A quoted cell can hold newlines (found by the parsers fuzz target): the error echoes it
     /// escaped and cut short, so it stays one line.
     #[test]
@@ -260,6 +443,98 @@ mod tests {
         assert!(
             !m.contains('\n') && m.contains("cannot parse") && m.contains("..."),
             "{m}"
+        );
+    }
+
+    /// Reading in pieces on every thread gives the rays, the error, its line and its ray index
+    /// that reading on one thread gives, over random files of good and bad rows, blank lines,
+    /// CRLF and lone CR line ends, quotes, bad UTF-8, a BOM and blank lines before the header.
+    #[test]
+    fn pieces_read_as_one_thread_reads() {
+        let rows: [&[u8]; 16] = [
+            b"1,2,3,0,0,1",
+            b" 1 , 2,\t3,0,1,0",
+            b"-0,1e-3,5,1,1,1",
+            b"0.5,0.25,0,0,-1,0",
+            b"",
+            b"",
+            b"0,0,0,0,0,0",
+            b"0,0,0,1,x,0",
+            b"0,0,0,1,0",
+            b"0,0,0,1,0,0,7,8,9",
+            b"0,0,,1,0,0",
+            b"nan,0,0,1,0,0",
+            b"0,\xff,0,1,0,0",
+            b"0,\"1\",0,1,0,0",
+            b"inf,0,0,1,0,0",
+            b"2,2,2,0,0,3",
+        ];
+        let heads: [&[u8]; 4] = [
+            b"ox,oy,oz,dx,dy,dz",
+            b"\nox,oy,oz,dx,dy,dz",
+            b"\xef\xbb\xbfdz,dy,dx,oz,oy,ox",
+            b"ox,oy,oz,dx,dy,dz,tmin,tmax",
+        ];
+        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |n: usize| {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng % n as u64) as usize
+        };
+        let (mut compared, mut in_pieces) = (0, 0);
+        for _ in 0..3000 {
+            let head = heads[next(heads.len())];
+            let mut text = head.to_vec();
+            // Mostly good rows, so some files get far before their first error.
+            let bad_rate = [0, 2, 40][next(3)];
+            for _ in 0..next(60) {
+                text.extend_from_slice(match next(5) {
+                    0 => b"\r\n".as_slice(),
+                    1 if next(20) == 0 => b"\r",
+                    _ => b"\n",
+                });
+                let row = if next(100) < bad_rate {
+                    rows[next(rows.len())]
+                } else {
+                    rows[next(6)]
+                };
+                let row = if head.ends_with(b"tmax") && !row.is_empty() {
+                    [row, b",0,5"].concat()
+                } else {
+                    row.to_vec()
+                };
+                text.extend_from_slice(&row);
+            }
+            if next(2) == 0 {
+                text.push(b'\n');
+            }
+            let label = Path::new("rays.csv");
+            let one = parse_text(&text, label, usize::MAX / 4);
+            let cut = parse_text(&text, label, 8);
+            match (&one, &cut) {
+                (Ok(a), Ok(b)) => assert_eq!(a, b),
+                (Err(a), Err(b)) => assert_eq!(
+                    (a.line, a.to_string()),
+                    (b.line, b.to_string()),
+                    "{}",
+                    String::from_utf8_lossy(&text).escape_debug()
+                ),
+                _ => panic!(
+                    "{one:?} vs {cut:?} for {}",
+                    String::from_utf8_lossy(&text).escape_debug()
+                ),
+            }
+            compared += 1;
+            let mut csv = csv::Reader::from_reader(text.as_slice());
+            if csv.headers().is_ok() {
+                let body = csv.position().byte() as usize;
+                in_pieces += usize::from(pieces(&text, body, 8).is_some_and(|p| p.len() > 1));
+            }
+        }
+        assert!(
+            compared == 3000 && in_pieces > 1000,
+            "{in_pieces} read in pieces"
         );
     }
 

@@ -13,6 +13,7 @@ pub mod clock;
 pub mod experiment;
 pub mod parallel;
 pub mod scene;
+pub mod text_lines;
 
 /// The README's Rust examples, compiled as doctests so that they stay true to the API.
 #[cfg(doctest)]

@@ -12,6 +12,8 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
+use crate::text_lines::line_at;
+
 use rdbvh_core::geometry::Ray;
 use rdbvh_core::Vec3;
 
@@ -105,24 +107,6 @@ impl RowError {
             reason,
         }
     }
-}
-
-/// The 1-based line of the row the CSV reader places at byte `at`: one more than the line ends
-/// (LF, CRLF or a lone CR, as the reader takes them) before its first byte. The reader's own line
-/// count is not used: after a CRLF it places the next row at the line feed and counts one line
-/// too few (a row on line 3 of a CRLF file was reported on line 2), so line-end bytes at `at`
-/// are skipped first.
-fn line_at(text: &[u8], at: u64) -> u64 {
-    let mut at = usize::try_from(at).unwrap_or(usize::MAX).min(text.len());
-    while matches!(text.get(at), Some(b'\r' | b'\n')) {
-        at += 1;
-    }
-    let before = &text[..at];
-    let feeds = before.iter().filter(|&&b| b == b'\n').count();
-    let lone_cr = |w: &[u8]| w[0] == b'\r' && w.get(1).is_none_or(|&b| b != b'\n');
-    let returns = before.windows(2).filter(|w| lone_cr(w)).count()
-        + usize::from(before.last() == Some(&b'\r'));
-    1 + (feeds + returns) as u64
 }
 
 fn parse_text(text: &[u8], label: &Path, piece: usize) -> Result<Vec<Ray>, RaysError> {

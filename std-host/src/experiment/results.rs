@@ -8,6 +8,7 @@ use rdbvh_core::analyze::THESIS_LEVELS;
 
 use super::run::RunMetrics;
 use super::ExperimentError;
+use crate::text_lines::line_at;
 
 /// The columns of the thesis's `Plane_*.csv` / `Point_*.csv` files, in their order. Every one is
 /// in `results.csv` under the same name. The four build-profile columns (`Compute cost PAH
@@ -245,7 +246,9 @@ fn read_table_checked(path: &Path, numeric: bool) -> Result<Table, ExperimentErr
                 .skip(1)
                 .find(|(_, v)| v.trim().parse::<f64>().is_err());
             if let Some((column, value)) = bad {
-                let line = rec.position().map_or(0, |p| p.line());
+                // Counted in the file itself: the reader's count misses CRLF lines.
+                let at = rec.position().map_or(0, |p| p.byte());
+                let line = std::fs::read(path).map_or(0, |text| line_at(&text, at));
                 return Err(ExperimentError::Csv(format!(
                     "{} line {line}: column `{column}` of {name} is `{value}`, not a number",
                     path.display()
@@ -323,6 +326,31 @@ mod tests {
             metrics: RunMetrics::default(),
         };
         assert_eq!(fields(&row).len(), h.len());
+    }
+
+    /// A non-numeric field of a thesis file names its line, also in a CRLF file.
+    #[test]
+    fn non_numeric_thesis_fields_name_their_line() {
+        let dir = std::env::temp_dir().join(format!("rdbvh-results-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for end in ["\n", "\r\n"] {
+            let file = dir.join("Plane_x.csv");
+            let text = [
+                "Scene,Hit percentage",
+                "A_Full,0.5",
+                "B_Full,0.25",
+                "C_Full,x",
+                "",
+            ]
+            .join(end);
+            std::fs::write(&file, text).unwrap();
+            let e = read_thesis_results(&dir).unwrap_err().to_string();
+            assert!(
+                e.contains("line 4: column `Hit percentage` of C_Full"),
+                "{end:?}: {e}"
+            );
+        }
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]

@@ -18,8 +18,8 @@ use rayon::prelude::*;
 use std::sync::Mutex;
 
 use rdbvh_core::build::{
-    BinJob, BuildArena, Builder, LoadedBounds, NodeBinner, NodeBins, PresetError, Subtree,
-    SubtreeSink, TriangleLoad,
+    BinJob, BuildArena, Builder, LoadedBounds, NodeBinner, NodeBins, Preset, PresetError,
+    PresetOptions, PresetVisitor, Subtree, SubtreeSink, TriangleLoad,
 };
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
@@ -95,6 +95,36 @@ where
     build_arena(builder, &mut arena)
 }
 
+/// Loads every triangle of `tris` into `arena` in parallel parts: the same primitives, and the
+/// same error for the first bad triangle, as `arena.load_triangles(tris)`.
+pub fn load_triangles(arena: &mut BuildArena, tris: &[Triangle]) -> Result<(), BuildError> {
+    arena.load_triangles_with(tris, load_parallel)
+}
+
+/// Builds `preset` (for `area`, when it needs one) over the primitives loaded in `arena` with
+/// every rayon thread. Equal to the tree of `preset.build_into(area, options, arena, ..)`.
+pub fn build_preset(
+    preset: Preset,
+    area: Option<&InfluenceArea>,
+    options: &PresetOptions,
+    arena: &mut BuildArena,
+) -> Result<Bvh, PresetError> {
+    /// Runs the preset's builder on every thread.
+    struct Threaded<'a>(&'a mut BuildArena);
+    impl PresetVisitor for Threaded<'_> {
+        type Output = Result<Bvh, BuildError>;
+        fn visit<A, C, T>(self, builder: Builder<A, C, T>) -> Self::Output
+        where
+            A: AxisChooser + Send + Sync,
+            C: CostModel + Send + Sync,
+            T: Termination + Send + Sync,
+        {
+            build_arena(&builder, self.0)
+        }
+    }
+    Ok(preset.with_builder(area, options, Threaded(arena))??)
+}
+
 /// Builds over the primitives loaded in `arena` with every rayon thread. Equal to
 /// `builder.build_into(arena, ..)`.
 pub fn build_arena<A, C, T>(
@@ -106,10 +136,16 @@ where
     C: CostModel + Sync,
     T: Termination + Sync,
 {
+    let cutoff = cutoff(arena.len());
+    if arena.len() <= cutoff as usize {
+        // The root would be the only job: no thread to share it with.
+        let mut bvh = Bvh::with_capacity(arena.len());
+        builder.build_into(arena, &mut bvh)?;
+        return Ok(bvh);
+    }
     let mut top = Bvh::with_capacity(arena.len());
     let mut jobs = Vec::new();
     let built = Mutex::new(Vec::new());
-    let cutoff = cutoff(arena.len());
     let top_built = rayon::scope(|scope| {
         let mut sink = Spawner {
             scope,
@@ -231,6 +267,7 @@ mod tests {
     use super::*;
     use rdbvh_core::build::{BuildConfig, ReinsertConfig};
     use rdbvh_core::heuristics::{AllAxes, PahPerspective, PerspectiveMeasure, SahTermination};
+    use rdbvh_core::influence::InfluenceArea;
     use rdbvh_core::influence::{PlaneArea, PointArea};
     use rdbvh_core::random::Pcg32;
     use rdbvh_core::toplevel::Octree;
@@ -283,6 +320,45 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn threaded_presets_equal_single_threaded() {
+        // Every preset, both kinds of area (one the soup straddles, so the window's border runs
+        // through the top nodes), the project's and the thesis's settings.
+        let tris = soup(30_000);
+        let areas: [InfluenceArea; 2] = [
+            PlaneArea::new(Vec3::new(2.0, 12.0, 0.0), -Vec3::Y, 6.0, 8.0, 30.0)
+                .unwrap()
+                .into(),
+            PointArea::new(Vec3::new(0.0, 13.0, 1.0), -Vec3::Y, 70.0, 90.0, 0.5, 30.0)
+                .unwrap()
+                .into(),
+        ];
+        for options in [PresetOptions::default(), PresetOptions::thesis()] {
+            for area in &areas {
+                for preset in Preset::ALL {
+                    let mut arena = BuildArena::with_capacity(tris.len());
+                    arena.load_triangles(&tris).unwrap();
+                    let mut serial = Bvh::with_capacity(tris.len());
+                    preset
+                        .build_into(Some(area), &options, &mut arena, &mut serial)
+                        .unwrap();
+                    load_triangles(&mut arena, &tris).unwrap();
+                    let threaded = build_preset(preset, Some(area), &options, &mut arena).unwrap();
+                    assert!(
+                        threaded == serial,
+                        "{preset} {area:?} {}",
+                        options.thesis_mode
+                    );
+                }
+            }
+        }
+        let mut arena = BuildArena::with_capacity(1);
+        assert_eq!(
+            build_preset(Preset::Full, None, &PresetOptions::default(), &mut arena),
+            Err(PresetError::NeedsArea(Preset::Full))
+        );
     }
 
     #[test]

@@ -20,6 +20,6 @@ pub use binning::{BinJob, NodeBinner, NodeBins, SerialBinner};
 pub use builder::{BuildStats, Builder, Subtree, SubtreeSink};
 pub use config::{BinSpace, BuildConfig, CutEvaluation, ThesisCut, MAX_BINS, MAX_EXHAUSTIVE};
 pub use graft::GraftError;
-pub use preset::{AreaPah, Preset, PresetError, PresetOptions};
+pub use preset::{AreaPah, Preset, PresetError, PresetOptions, PresetVisitor};
 pub use profile::{Clock, NoClock, PhaseProfile};
 pub use reinsert::{reinsert, ReinsertConfig, ReinsertStats, Reinserter};

@@ -312,6 +312,36 @@ impl Preset {
         out: &mut Bvh,
         clock: &impl Clock,
     ) -> Result<BuildStats, PresetError> {
+        /// Builds into the caller's arena and tree.
+        struct IntoArena<'a, K> {
+            arena: &'a mut BuildArena,
+            out: &'a mut Bvh,
+            clock: &'a K,
+        }
+        impl<K: Clock> PresetVisitor for IntoArena<'_, K> {
+            type Output = Result<BuildStats, BuildError>;
+            fn visit<A, C, T>(self, builder: Builder<A, C, T>) -> Self::Output
+            where
+                A: AxisChooser + Send + Sync,
+                C: CostModel + Send + Sync,
+                T: Termination + Send + Sync,
+            {
+                builder.build_into_profiled(self.arena, self.out, self.clock)
+            }
+        }
+        Ok(self.with_builder(area, options, IntoArena { arena, out, clock })??)
+    }
+
+    /// Hands `visitor` the builder this preset names for `area` and `options`, statically
+    /// dispatched: how a host runs a preset its own way (`rdbvh::parallel` builds it on every
+    /// thread) without a second copy of which chooser, cost model and termination each preset
+    /// takes. `area` is required for `facing`, `longest`, `full` and `pah`.
+    pub fn with_builder<V: PresetVisitor>(
+        self,
+        area: Option<&InfluenceArea>,
+        options: &PresetOptions,
+        visitor: V,
+    ) -> Result<V::Output, PresetError> {
         let lsph = CutEvaluation::Thesis(ThesisCut {
             quality_threshold: options.lsph_quality_threshold,
             ..options.cut
@@ -321,121 +351,107 @@ impl Preset {
             (true, None) => return Err(PresetError::NeedsArea(self)),
             (_, a) => a,
         };
-        match (self, area) {
+        Ok(match (self, area) {
             (Preset::Sah, _) => run(
                 AllAxes,
                 Sah,
                 options,
                 options.config(CutEvaluation::BestOfAxes),
-                arena,
-                out,
-                clock,
+                visitor,
             ),
-            (Preset::Standard, _) => run(
-                LongestAxis,
-                Sah,
-                options,
-                options.config(lsph),
-                arena,
-                out,
-                clock,
-            ),
+            (Preset::Standard, _) => run(LongestAxis, Sah, options, options.config(lsph), visitor),
             (Preset::Facing, Some(a)) => run(
                 Spfh::for_area(a),
                 Sah,
                 options,
                 options.config(spfh),
-                arena,
-                out,
-                clock,
+                visitor,
             ),
             (Preset::Longest, Some(InfluenceArea::Plane(a))) => run(
                 LongestAxis,
                 PahOrtho::for_area(a),
                 options,
                 options.config(lsph),
-                arena,
-                out,
-                clock,
+                visitor,
             ),
             (Preset::Longest, Some(InfluenceArea::Point(a))) => run(
                 LongestAxis,
                 PahPerspective::for_area(a, options.perspective),
                 options,
                 options.config(lsph),
-                arena,
-                out,
-                clock,
+                visitor,
             ),
             (Preset::Full, Some(area @ InfluenceArea::Plane(a))) => run(
                 Spfh::for_area(area),
                 PahOrtho::for_area(a),
                 options,
                 options.config(spfh),
-                arena,
-                out,
-                clock,
+                visitor,
             ),
             (Preset::Full, Some(area @ InfluenceArea::Point(a))) => run(
                 Spfh::for_area(area),
                 PahPerspective::for_area(a, options.perspective),
                 options,
                 options.config(spfh),
-                arena,
-                out,
-                clock,
+                visitor,
             ),
             (Preset::Pah, Some(InfluenceArea::Plane(a))) => run(
                 AllAxes,
                 PahOrtho::for_area(a),
                 options,
                 options.config(CutEvaluation::BestOfAxes),
-                arena,
-                out,
-                clock,
+                visitor,
             ),
             (Preset::Pah, Some(InfluenceArea::Point(a))) => run(
                 AllAxes,
                 PahPerspective::for_area(a, options.perspective),
                 options,
                 options.config(CutEvaluation::BestOfAxes),
-                arena,
-                out,
-                clock,
+                visitor,
             ),
-            (_, None) => Err(PresetError::NeedsArea(self)),
-        }
+            (_, None) => return Err(PresetError::NeedsArea(self)),
+        })
     }
 }
 
-/// One monomorphised build per (chooser, cost model), with the options' termination rule.
-fn run<A: AxisChooser, C: CostModel>(
+/// What to do with the builder a preset names: [`Preset::with_builder`] calls `visit` once with
+/// it. The bounds hold for every preset's parts, so a visitor may share the builder across
+/// threads.
+pub trait PresetVisitor {
+    /// What the visit returns.
+    type Output;
+    /// Runs the preset's builder.
+    fn visit<A, C, T>(self, builder: Builder<A, C, T>) -> Self::Output
+    where
+        A: AxisChooser + Send + Sync,
+        C: CostModel + Send + Sync,
+        T: Termination + Send + Sync;
+}
+
+/// The builder of a (chooser, cost model) pair with the options' termination rule, handed to
+/// `visitor`: one monomorphised build per pair.
+fn run<A, C, V>(
     axes: A,
     cost: C,
     options: &PresetOptions,
     config: BuildConfig,
-    arena: &mut BuildArena,
-    out: &mut Bvh,
-    clock: &impl Clock,
-) -> Result<BuildStats, PresetError> {
-    fn go<A: AxisChooser, C: CostModel, T: Termination>(
-        b: Builder<A, C, T>,
-        arena: &mut BuildArena,
-        out: &mut Bvh,
-        clock: &impl Clock,
-    ) -> Result<BuildStats, PresetError> {
-        Ok(b.build_into_profiled(arena, out, clock)?)
-    }
+    visitor: V,
+) -> V::Output
+where
+    A: AxisChooser + Send + Sync,
+    C: CostModel + Send + Sync,
+    V: PresetVisitor,
+{
     if options.thesis_mode {
         let stop = LeafSize {
             max_leaf: options.max_leaf,
         };
-        go(Builder::new(axes, cost, stop, config), arena, out, clock)
+        visitor.visit(Builder::new(axes, cost, stop, config))
     } else {
         let stop = SahTermination {
             max_leaf: options.max_leaf,
         };
-        go(Builder::new(axes, cost, stop, config), arena, out, clock)
+        visitor.visit(Builder::new(axes, cost, stop, config))
     }
 }
 

@@ -61,7 +61,7 @@ pub struct BuildReport {
     pub load_ms: f64,
     /// With an area: milliseconds to pick the triangles that overlap it (the separating-axis test).
     pub select_ms: Option<f64>,
-    /// Milliseconds of the build alone.
+    /// Milliseconds of the build alone, on `threads` threads (the single-threaded build's tree).
     pub build_ms: f64,
     /// With `--reinsert`: milliseconds of the reinsertion after the build (not in `build_ms`).
     pub reinsert_ms: Option<f64>,
@@ -69,6 +69,8 @@ pub struct BuildReport {
     pub reinsert_moved: Option<u32>,
     /// Millions of triangles built per second.
     pub mtris_per_s: f64,
+    /// Threads the build ran on (rayon's pool: every core, or `RAYON_NUM_THREADS`).
+    pub threads: usize,
     /// The split-axis chooser: `sah` (all three axes), `lsph` (longest) or `spfh` (facing).
     pub builder: &'static str,
     /// The preset, with `--preset`.
@@ -143,6 +145,7 @@ pub fn run(args: &BuildArgs, out: &mut impl Write) -> Result<(), CliError> {
         reinsert_ms: built.reinsert.map(|(_, s)| s * 1e3),
         reinsert_moved: built.reinsert.map(|(r, _)| r.moved),
         mtris_per_s: built.mtris_per_s(triangles),
+        threads: rayon::current_num_threads(),
         builder: args.builder.chooser_name(),
         preset: args.builder.preset().map(|p| p.name()),
         thesis_mode: args.builder.thesis_mode,
@@ -198,8 +201,8 @@ fn table(r: &BuildReport) -> String {
         s += &format!("select time {select:.3} ms\n");
     }
     s += &format!(
-        "build time  {:.3} ms ({:.2} Mtris/s)",
-        r.build_ms, r.mtris_per_s
+        "build time  {:.3} ms ({:.2} Mtris/s, {} threads)",
+        r.build_ms, r.mtris_per_s, r.threads
     );
     if let (Some(ms), Some(moved)) = (r.reinsert_ms, r.reinsert_moved) {
         s += &format!("\nreinsert    {ms:.3} ms ({moved} nodes moved)");

@@ -5,7 +5,7 @@ use std::time::Instant;
 use clap::builder::PossibleValue;
 use clap::{value_parser, Args, ValueEnum};
 use rdbvh_core::build::{
-    reinsert, BuildArena, BuildConfig, BuildStats, Builder, Preset, PresetOptions, ReinsertConfig,
+    reinsert, BuildArena, BuildConfig, Builder, Preset, PresetOptions, ReinsertConfig,
     ReinsertStats, MAX_BINS,
 };
 use rdbvh_core::bvh::Bvh;
@@ -15,6 +15,7 @@ use rdbvh_core::influence::InfluenceArea;
 use serde::Serialize;
 
 use super::CliError;
+use crate::parallel;
 
 /// Which split axes the binned SAH builder tries.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Serialize)]
@@ -111,10 +112,9 @@ pub struct BuilderArgs {
 pub struct BuiltBvh {
     /// The BVH.
     pub bvh: Bvh,
-    /// The builder's counters.
-    pub stats: BuildStats,
-    /// Wall-clock seconds of loading the arena and building, not counting allocation: the
-    /// arena and output are sized first, as a renderer that rebuilds every frame would keep them.
+    /// Wall-clock seconds of loading the arena and building on every thread. The arena is sized
+    /// first, as a renderer that rebuilds every frame would keep it; the threaded build
+    /// allocates its tree and its jobs' arenas as it goes.
     pub seconds: f64,
     /// With --reinsert: what reinsertion did, and its wall-clock seconds (not in `seconds`).
     pub reinsert: Option<(ReinsertStats, f64)>,
@@ -211,13 +211,14 @@ impl BuilderArgs {
         }
     }
 
-    /// Builds a BVH over all `triangles` (single-threaded, as the core's builder is).
+    /// Builds a BVH over all `triangles` on every thread (the single-threaded build's tree).
     pub fn build(&self, triangles: &[Triangle]) -> Result<BuiltBvh, CliError> {
         self.build_over(triangles, None, None)
     }
 
     /// Builds a BVH over the triangles of `triangles` whose ids `subset` lists (all when
-    /// `None`), for the influence area `area` when the preset needs one.
+    /// `None`), for the influence area `area` when the preset needs one, on every thread of the
+    /// current rayon pool ([`crate::parallel`]: the single-threaded build's tree, node for node).
     pub fn build_over(
         &self,
         triangles: &[Triangle],
@@ -227,24 +228,23 @@ impl BuilderArgs {
         self.check_area(area.is_some())?;
         let n = subset.map_or(triangles.len(), <[u32]>::len);
         let mut arena = BuildArena::with_capacity(n);
-        let mut bvh = Bvh::with_capacity(n);
+        // The pool starts its threads on first use: not part of a build.
+        rayon::current_num_threads();
         let start = Instant::now();
         match subset {
             Some(ids) => arena.load_triangle_subset(triangles, ids.iter().copied())?,
-            None => arena.load_triangles(triangles)?,
+            None => parallel::load_triangles(&mut arena, triangles)?,
         }
-        let stats = match self.preset() {
-            Some(p) => p.build_into(area, &self.preset_options(), &mut arena, &mut bvh)?,
+        let mut bvh = match self.preset() {
+            Some(p) => parallel::build_preset(p, area, &self.preset_options(), &mut arena)?,
             // Only the bins and the leaf size change: each builder keeps the rest of its own
             // configuration (LSPH evaluates its first axis only, which a default config would
             // undo).
             None => match self.kind() {
-                BuilderKind::Sah => self
-                    .apply(Builder::sah())
-                    .build_into(&mut arena, &mut bvh)?,
-                BuilderKind::Lsph => self
-                    .apply(Builder::lsph())
-                    .build_into(&mut arena, &mut bvh)?,
+                BuilderKind::Sah => parallel::build_arena(&self.apply(Builder::sah()), &mut arena)?,
+                BuilderKind::Lsph => {
+                    parallel::build_arena(&self.apply(Builder::lsph()), &mut arena)?
+                }
             },
         };
         let seconds = start.elapsed().as_secs_f64();
@@ -259,7 +259,6 @@ impl BuilderArgs {
         });
         Ok(BuiltBvh {
             bvh,
-            stats,
             seconds,
             reinsert,
         })
@@ -304,7 +303,12 @@ mod tests {
                 .bvh
                 .validate(tris.len(), |id| tris[id as usize].bounds())
                 .unwrap();
-            assert_eq!(built.stats.nodes as usize, built.bvh.nodes().len());
+            // Built on every thread, the single-threaded builder's tree.
+            let serial = match builder {
+                BuilderKind::Sah => args.apply(Builder::sah()).build(&tris),
+                BuilderKind::Lsph => args.apply(Builder::lsph()).build(&tris),
+            };
+            assert_eq!(built.bvh, serial.unwrap());
             assert!(built.bvh.nodes().iter().all(|n| n.count <= 2));
         }
     }

@@ -19,12 +19,13 @@ pub fn top() -> String {
 }
 
 const PRESETS: &str = "\
-Presets (--preset NAME; the thesis's names):
+Presets (--preset NAME; the thesis's four pairs, and this project's sah and pah):
   sah        binned SAH over all three axes (the state of the art; the fallback BVH)
   standard   SAH + longest axis (LSPH)
   facing     SAH + splitting plane facing (SPFH)       needs --areas
   longest    PAH + LSPH                                needs --areas
   full       PAH + SPFH                                needs --areas
+  pah        PAH over all three axes (sah's builder)   needs --areas
 --thesis-mode builds as the thesis did: 41 bins over the node box, leaves of at most 2 triangles by
 size alone; --bins and --max-leaf still override it. --builder sah|lsph is the plain binned SAH
 builder (all axes, or the longest axis only); it and --preset exclude each other.";
@@ -62,10 +63,12 @@ pub fn build() -> String {
          the expected cost per ray of the area's rays under its PAH. Both costs use C_trav =\n\
          C_isect = 1, or with --thesis-mode the thesis's 2 x 1.0 per inner node and 1.2 per\n\
          triangle (as analyze and experiment report them).\n\
+         The build runs on every thread (RAYON_NUM_THREADS sets how many) and makes the\n\
+         single-threaded build's tree, node for node; build_ms is its wall time.\n\
          --json prints one object with the keys scene, triangles (in the build), scene_triangles,\n\
          nodes, leaves, max_depth, sah_cost, pah_cost, bytes, load_ms, select_ms, build_ms,\n\
-         reinsert_ms, reinsert_moved, mtris_per_s, builder, preset, thesis_mode, area_kind, bins,\n\
-         max_leaf (null where they do not apply).\n\n\
+         reinsert_ms, reinsert_moved, mtris_per_s, threads, builder, preset, thesis_mode,\n\
+         area_kind, bins, max_leaf (null where they do not apply).\n\n\
          {AREAS}\n\n\
          Examples:\n  \
          rdbvh build scene.obj --preset sah --json\n  \

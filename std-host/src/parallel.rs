@@ -206,8 +206,8 @@ where
     }
 }
 
-/// Builds a [`Scene`] with its local BVHs and its fallback BVH on all threads; equal to
-/// [`Scene::build`]'s scene.
+/// Builds a [`Scene`] with its local BVHs (one per thread at a time) and its fallback BVH (itself
+/// threaded) on all threads; equal to [`Scene::build`]'s scene.
 pub fn build_scene<L: AreaLookup>(
     tris: &[Triangle],
     areas: Vec<InfluenceArea>,
@@ -232,15 +232,11 @@ pub fn build_scene<L: AreaLookup>(
         options.reinsert_local(area, &mut bvh);
         Ok(bvh)
     };
+    // The fallback, over every triangle, is itself built on every thread.
     let fallback_build = || {
         let mut arena = BuildArena::with_capacity(tris.len());
-        arena
-            .load_triangles(tris)
-            .map_err(|e| SceneError::Fallback(e.into()))?;
-        let mut bvh = Bvh::with_capacity(tris.len());
-        options
-            .fallback_preset
-            .build_into(None, &options.fallback, &mut arena, &mut bvh)
+        load_triangles(&mut arena, tris).map_err(|e| SceneError::Fallback(e.into()))?;
+        let mut bvh = build_preset(options.fallback_preset, None, &options.fallback, &mut arena)
             .map_err(SceneError::Fallback)?;
         options.reinsert_fallback(&mut bvh);
         Ok::<_, SceneError>(bvh)

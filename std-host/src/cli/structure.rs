@@ -12,13 +12,15 @@ use rdbvh_core::bvh::{Bvh, TraversalStats};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::CostConstants;
 use rdbvh_core::toplevel::{
-    AreaLookup, Scene as Structure, SceneOptions, SceneStats, DEFAULT_OCTREE_LEVELS,
+    AreaList, AreaLookup, Octree, Scene as Structure, SceneOptions, SceneStats,
+    DEFAULT_OCTREE_LEVELS,
 };
 
 use super::areas::load_areas;
 use super::rays::read_rays;
 use super::trace::{write_answers, Answers, LookupKind, TraceArgs};
 use super::{load_scene, CliError};
+use crate::parallel::build_scene;
 
 /// The preset of the local BVHs when `--preset` is not given: the thesis's full method.
 pub const DEFAULT_LOCAL_PRESET: Preset = Preset::Full;
@@ -186,11 +188,15 @@ pub fn run(args: &TraceArgs, areas_path: &Path, log: &mut impl Write) -> Result<
     let areas: Vec<_> = entries.iter().map(|e| e.area).collect();
     let options = structure_options(args);
 
+    // The pool starts its threads on first use: not part of the build.
+    rayon::current_num_threads();
     let start = Instant::now();
     match args.lookup {
         LookupKind::Octree => {
             let levels = args.octree_levels.unwrap_or(DEFAULT_OCTREE_LEVELS);
-            let s = Structure::with_octree(&scene.triangles, areas, &options, levels)?;
+            let s = build_scene(&scene.triangles, areas, &options, |a| {
+                Octree::build(a, levels)
+            })?;
             let build_seconds = start.elapsed().as_secs_f64();
             let o = s.lookup().stats();
             let lookup = format!(
@@ -200,7 +206,9 @@ pub fn run(args: &TraceArgs, areas_path: &Path, log: &mut impl Write) -> Result<
             finish(args, &scene, &rays, &s, &lookup, build_seconds, log)
         }
         LookupKind::List => {
-            let s = Structure::with_list(&scene.triangles, areas, &options)?;
+            let s = build_scene(&scene.triangles, areas, &options, |a| {
+                AreaList::new(a.len())
+            })?;
             let build_seconds = start.elapsed().as_secs_f64();
             finish(args, &scene, &rays, &s, "area list", build_seconds, log)
         }

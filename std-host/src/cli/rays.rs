@@ -109,6 +109,7 @@ impl RowError {
     }
 }
 
+/// [`parse_rays`] over text in memory, cut into pieces of at least `piece` bytes when it can be.
 fn parse_text(text: &[u8], label: &Path, piece: usize) -> Result<Vec<Ray>, RaysError> {
     let error = |line: Option<u64>, reason: String| RaysError {
         path: label.to_path_buf(),
@@ -201,8 +202,8 @@ fn parse_text(text: &[u8], label: &Path, piece: usize) -> Result<Vec<Ray>, RaysE
         }
     }
     let mut rays = Vec::with_capacity(parsed.iter().map(|(rays, _)| rays.len()).sum());
-    for (piece, _) in parsed {
-        rays.extend(piece);
+    for (part, _) in parsed {
+        rays.extend(part);
     }
     Ok(rays)
 }

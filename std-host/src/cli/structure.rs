@@ -188,8 +188,7 @@ pub fn run(args: &TraceArgs, areas_path: &Path, log: &mut impl Write) -> Result<
     let areas: Vec<_> = entries.iter().map(|e| e.area).collect();
     let options = structure_options(args);
 
-    // The pool starts its threads on first use: not part of the build.
-    rayon::current_num_threads();
+    crate::parallel::start_pool();
     let start = Instant::now();
     match args.lookup {
         LookupKind::Octree => {

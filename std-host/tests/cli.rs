@@ -1031,3 +1031,101 @@ fn trace_through_the_structure_on_thesis_scenes() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Found by black-box testing: `trace` hit a 12-unit triangle at the origin with a ray from 1e8
+/// units away that passed 3 units beside it. Rays from 1e6 to 1e10 units away now answer as
+/// exact arithmetic on the rays' own f32 values (as read from the file) does, except within 1e-3
+/// of the triangle's size of an edge.
+#[test]
+fn trace_decides_far_rays_by_the_scene_not_the_origin() {
+    let dir = scratch("far-rays");
+    let obj = dir.join("triangle.obj");
+    std::fs::write(&obj, "v -6 -6 0.5\nv 6 -6 -0.5\nv 0 6 0\nf 1 2 3\n").unwrap();
+    let tri = Scene::open(obj.to_str().unwrap()).unwrap().triangles[0];
+    let mut rng = Mt19937::new(11);
+    let mut uniform = |lo: f32, hi: f32| lo + (hi - lo) * (rng.next_u32() as f32 / u32::MAX as f32);
+    let mut rays = Vec::new();
+    for i in 0..400 {
+        let distance = [1e6f32, 1e8, 1e10][i % 3];
+        let (theta, phi) = (uniform(0.1, 1.4), uniform(0.0, std::f32::consts::TAU));
+        let from = Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        );
+        let origin = from * distance;
+        let target = Vec3::new(uniform(-12.0, 12.0), uniform(-12.0, 12.0), 0.0);
+        let d = target - origin;
+        rays.push([
+            origin.x,
+            origin.y,
+            origin.z,
+            d.x,
+            d.y,
+            d.z,
+            0.0,
+            f32::INFINITY,
+        ]);
+    }
+    let rays_csv = dir.join("rays.csv");
+    let rays = write_rays(&rays_csv, &rays);
+    let hits_csv = dir.join("hits.csv");
+    let out = rdbvh(&[
+        "trace",
+        obj.to_str().unwrap(),
+        "--rays",
+        rays_csv.to_str().unwrap(),
+        "--out",
+        hits_csv.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let answers = std::fs::read_to_string(&hits_csv).unwrap();
+    let f64s = |v: Vec3| v.to_array().map(f64::from);
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let (v0, e1, e2) = (
+        f64s(tri.v0),
+        sub(f64s(tri.v1), f64s(tri.v0)),
+        sub(f64s(tri.v2), f64s(tri.v0)),
+    );
+    let (mut inside, mut outside) = (0, 0);
+    for (line, ray) in answers.lines().skip(1).zip(&rays) {
+        // Moller-Trumbore in f64 on the ray as the file gives it.
+        let p = cross(f64s(ray.dir), e2);
+        let det = dot(e1, p);
+        let s = sub(f64s(ray.origin), v0);
+        let q = cross(s, e1);
+        let (u, v) = (dot(s, p) / det, dot(f64s(ray.dir), q) / det);
+        if [u, v, 1.0 - u - v].iter().any(|x| x.abs() < 1e-3) {
+            continue;
+        }
+        let f: Vec<&str> = line.split(',').collect();
+        if u > 0.0 && v > 0.0 && u + v < 1.0 {
+            let missed = || panic!("{ray:?}: missed, exact u {u} v {v}");
+            let (hu, hv): (f64, f64) = (
+                f[3].parse().unwrap_or_else(|_| missed()),
+                f[4].parse().unwrap_or_else(|_| missed()),
+            );
+            assert!(
+                (hu - u).abs() < 1e-3 && (hv - v).abs() < 1e-3,
+                "{ray:?}: {line}, exact u {u} v {v}"
+            );
+            inside += 1;
+        } else {
+            assert_eq!(&f[1..], ["", "", "", ""], "{ray:?}: exact u {u} v {v}");
+            outside += 1;
+        }
+    }
+    assert!(
+        inside > 40 && outside > 40,
+        "{inside} inside, {outside} outside"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -372,4 +372,72 @@ mod tests {
             );
         }
     }
+
+    /// Rays from 1e3 to 1e10 units away, aimed at triangles (in f32 a ray from 1e10 units can
+    /// only aim to within about 600 units, so most of those miss): where exact arithmetic on the
+    /// rays' own values leaves no hit within 1e-4 of an edge, the closest hit is exact
+    /// arithmetic's, and the binary and the 4-wide tree give brute force's answer, so their box
+    /// tests from far origins cull nothing the anchored triangle test hits (`Ray::anchor`).
+    #[test]
+    fn far_rays_answer_as_exact_arithmetic() {
+        // Miri runs a small scene and a few rays.
+        let n = if cfg!(miri) { 40 } else { 300 };
+        let tris = crate::test_scenes::soup(n, 11, -10.0, 10.0, 2.0);
+        let bvh = Builder::sah().build(&tris).unwrap();
+        let wide = crate::bvh::WideBvh::from_binary(&bvh, &tris);
+        let mut rng = crate::random::Pcg32::new(12);
+        let (mut hits, mut decided) = (0, 0);
+        let rays = if cfg!(miri) { 8 } else { 800 };
+        for i in 0..rays {
+            let aim = tris[i % tris.len()].centroid();
+            let w = Vec3::new(
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+            );
+            let distance = [1e3f32, 1e5, 1e8, 1e10][i % 4];
+            let origin = aim + w.normalize_or(Vec3::Y) * distance;
+            let Ok(ray) = Ray::new(origin, aim - origin) else {
+                continue;
+            };
+            let expect = brute_force::closest_hit(&ray, &tris);
+            assert_eq!(bvh.closest_hit(&ray, &tris), expect, "{ray:?}");
+            assert_eq!(wide.closest_hit(&ray), expect, "{ray:?}");
+            assert_eq!(bvh.any_hit(&ray, &tris), expect.is_some());
+            assert_eq!(wide.any_hit(&ray), expect.is_some());
+            // Exact arithmetic's closest hit, unless some triangle's decision is too close to call.
+            let mut exact: Option<(f64, usize)> = None;
+            let mut close_call = false;
+            for (k, tri) in tris.iter().enumerate() {
+                let n = (tri.v1 - tri.v0).cross(tri.v2 - tri.v0);
+                if n.length() < 1e-2 || n.normalize().dot(ray.dir.normalize()).abs() < 0.05 {
+                    // Slivers and grazing rays are the noise check's business.
+                    close_call |=
+                        brute_force::closest_hit(&ray, core::slice::from_ref(tri)).is_some();
+                    continue;
+                }
+                let (t, u, v) = crate::test_scenes::exact_intersection(tri, &ray);
+                close_call |= t > 0.0 && [u, v, 1.0 - u - v].iter().any(|x| x.abs() < 1e-4);
+                if t > 0.0 && u > 0.0 && v > 0.0 && u + v < 1.0 && exact.is_none_or(|(b, _)| t < b)
+                {
+                    exact = Some((t, k));
+                }
+            }
+            if close_call {
+                continue;
+            }
+            decided += 1;
+            assert_eq!(expect.is_some(), exact.is_some(), "{ray:?}: {expect:?}");
+            if let (Some(h), Some((t, _))) = (expect, exact) {
+                // Closest to `t`'s own resolution: from 1e10 units one ulp of `t` is 600 units,
+                // and triangles closer together than that along the ray tie (lower id wins).
+                assert!((f64::from(h.t) - t).abs() <= 4.0 * f64::EPSILON.max(t * 2f64.powi(-23)));
+                hits += 1;
+            }
+        }
+        assert!(
+            decided > rays / 2 && hits > rays / 8,
+            "{decided} decided, {hits} hits"
+        );
+    }
 }

@@ -35,6 +35,10 @@ impl core::error::Error for RayError {}
 /// A ray segment. `t` is measured in units of `dir`, which is not normalised: hit distances are
 /// parametric, as a renderer that passes a light sample's unnormalised direction with `t_max = 1`
 /// expects. A segment with `t_min > t_max` is empty and hits nothing.
+///
+/// Make rays with [`Ray::new`] or [`Ray::segment`] (or from one of those with struct update
+/// syntax that changes only `t_min` and `t_max`): the fields after `t_max` are derived from the
+/// origin and the direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
     /// Where the ray starts (at `t = 0`).
@@ -48,6 +52,32 @@ pub struct Ray {
     pub t_min: f32,
     /// End of the segment (may be `+inf`).
     pub t_max: f32,
+    /// The ray's anchor: the point of its line nearest the world origin, when that lies ahead of
+    /// the origin (`t > 0`), else the origin itself. See [`Ray::anchor`].
+    pub(crate) anchor: Vec3,
+    /// The ray parameter of [`Ray::anchor`] (0 when the anchor is the origin).
+    pub(crate) anchor_t: f32,
+}
+
+/// The anchor of the line `origin + t dir`: `(t_a, origin + t_a dir)` with `t_a` the parameter of
+/// the point nearest the world origin, or `(0, origin)` when that point is not ahead (`t_a <= 0`).
+///
+/// Computed in f64 and rounded once: `t_a` to f32 first, then the point at that very `t_a`, so the
+/// anchor lies on the ray to the rounding of its own coordinates (in f32 `origin + t_a dir` would
+/// be off the line by the rounding of the origin's coordinates, the error the anchor removes).
+fn anchor_of(origin: Vec3, dir: Vec3) -> (f32, Vec3) {
+    let o = origin.to_array().map(f64::from);
+    let d = dir.to_array().map(f64::from);
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    // For a finite, non-zero `d`, `d . d` is positive and finite in f64 (as are all these
+    // products of f32 values); the quotient can still exceed f32's range along a tiny direction,
+    // where the anchor would not be a point: then, as for NaN from a bad ray, there is none.
+    let t = (-dot(o, d) / dot(d, d)) as f32;
+    if !(t > 0.0 && t.is_finite()) {
+        return (0.0, origin);
+    }
+    let at = |k: usize| (o[k] + d[k] * f64::from(t)) as f32;
+    (t, Vec3::new(at(0), at(1), at(2)))
 }
 
 impl Ray {
@@ -71,15 +101,39 @@ impl Ray {
         if t_min.is_nan() || t_max.is_nan() {
             return Err(RayError::NanSegment);
         }
+        Ok(Self::unchecked(origin, dir, t_min, t_max))
+    }
+
+    /// [`Ray::segment`] without its checks, for callers that hold finite values by construction.
+    pub(crate) fn unchecked(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
         // `-0.0 + 0.0 == +0.0`: canonical zero components give `+inf` inverses.
         let canonical = dir + Vec3::ZERO;
-        Ok(Self {
+        let (anchor_t, anchor) = anchor_of(origin, dir);
+        Self {
             origin,
             dir,
             inv_dir: Vec3::ONE / canonical,
             t_min,
             t_max,
-        })
+            anchor,
+            anchor_t,
+        }
+    }
+
+    /// Where the triangle tests measure from: the point of the ray's line nearest the world
+    /// origin, when it lies ahead of the origin, and its ray parameter; else the origin and 0.
+    ///
+    /// Moller-Trumbore's edge decisions carry an f32 error proportional to the distance between
+    /// the point it measures from and the triangle. Measured from the origin, a ray from 1e8
+    /// units away decides within 8 units of a 12-unit triangle's edges: noise. The anchor is
+    /// never farther from the world origin than any point of the ray ahead of it, hits included,
+    /// so measured from it the error is that of the scene's own coordinates, wherever the ray
+    /// starts. The hit's `t` is the anchor's plus the test's own. The anchor depends on the
+    /// origin and the direction alone, so every structure and the brute-force oracle, given the
+    /// same ray (or a segment of it), decide alike.
+    #[inline]
+    pub fn anchor(&self) -> (f32, Vec3) {
+        (self.anchor_t, self.anchor)
     }
 
     /// The point at parameter `t`.

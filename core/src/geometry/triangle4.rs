@@ -42,11 +42,13 @@ pub struct Hits4 {
     pub v: [f32; 4],
 }
 
-/// A ray's origin and direction splatted over four lanes, and the direction itself for the
+/// A ray's anchor and direction splatted over four lanes, and the direction itself for the
 /// determinant check, prepared once per ray.
 #[derive(Clone, Copy, Debug)]
 pub struct RayTri4 {
-    origin: [f32x4; 3],
+    /// The ray's anchor ([`Ray::anchor`]), where the test measures from.
+    anchor: [f32x4; 3],
+    anchor_t: f32x4,
     dir: [f32x4; 3],
     dir3: Vec3,
     t_min: f32x4,
@@ -58,7 +60,8 @@ impl RayTri4 {
     pub fn new(ray: &Ray) -> Self {
         let s = f32x4::splat;
         Self {
-            origin: [s(ray.origin.x), s(ray.origin.y), s(ray.origin.z)],
+            anchor: [s(ray.anchor.x), s(ray.anchor.y), s(ray.anchor.z)],
+            anchor_t: s(ray.anchor_t),
             dir: [s(ray.dir.x), s(ray.dir.y), s(ray.dir.z)],
             dir3: ray.dir,
             t_min: s(ray.t_min),
@@ -127,14 +130,14 @@ impl Triangle4 {
         let det = dot(e1, p);
         let inv_det = f32x4::ONE / det;
         let s = [
-            ray.origin[0] - v0[0],
-            ray.origin[1] - v0[1],
-            ray.origin[2] - v0[2],
+            ray.anchor[0] - v0[0],
+            ray.anchor[1] - v0[1],
+            ray.anchor[2] - v0[2],
         ];
         let u = dot(s, p) * inv_det;
         let q = cross(s, e1);
         let v = dot(ray.dir, q) * inv_det;
-        let t = dot(e2, q) * inv_det;
+        let t = ray.anchor_t + dot(e2, q) * inv_det;
         let zero = f32x4::ZERO;
         let one = f32x4::ONE;
         // Each comparison is false for NaN, as in the scalar test.

@@ -78,13 +78,8 @@ impl RaySampler {
             InfluenceArea::Point(a) => self.point(&a),
         };
         // Origins and directions are finite and directions unit by construction.
-        Ray::new(origin, dir).unwrap_or(Ray {
-            origin,
-            dir: Vec3::Z,
-            inv_dir: Vec3::new(f32::INFINITY, f32::INFINITY, 1.0),
-            t_min: 0.0,
-            t_max: f32::INFINITY,
-        })
+        Ray::new(origin, dir)
+            .unwrap_or_else(|_| Ray::unchecked(origin, Vec3::Z, 0.0, f32::INFINITY))
     }
 
     fn plane(&mut self, a: &PlaneArea) -> (Vec3, Vec3) {

@@ -36,9 +36,10 @@ impl core::error::Error for RayError {}
 /// parametric, as a renderer that passes a light sample's unnormalised direction with `t_max = 1`
 /// expects. A segment with `t_min > t_max` is empty and hits nothing.
 ///
-/// Make rays with [`Ray::new`] or [`Ray::segment`] (or from one of those with struct update
-/// syntax that changes only `t_min` and `t_max`): the fields after `t_max` are derived from the
-/// origin and the direction.
+/// Make rays with [`Ray::new`] or [`Ray::segment`]: the private fields ([`Ray::anchor`]) are
+/// derived from the origin and the direction, so change a ray's `origin` or `dir` by making a new
+/// one. A part of a ray, `Ray::segment(ray.origin, ray.dir, lo, hi)`, keeps its anchor and so its
+/// answers.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
     /// Where the ray starts (at `t = 0`).

@@ -58,27 +58,33 @@ pub struct Ray {
     pub(crate) anchor: Vec3,
     /// The ray parameter of [`Ray::anchor`] (0 when the anchor is the origin).
     pub(crate) anchor_t: f32,
+    /// `dot(origin, dir) + anchor_t |dir|^2 / 2`: a point `p` is nearer the anchor than the
+    /// origin exactly when `dot(p, dir)` exceeds it (see [`Ray::anchor_is_nearer`]).
+    pub(crate) anchor_split: f32,
 }
 
-/// The anchor of the line `origin + t dir`: `(t_a, origin + t_a dir)` with `t_a` the parameter of
-/// the point nearest the world origin, or `(0, origin)` when that point is not ahead (`t_a <= 0`).
+/// The anchor of the line `origin + t dir`: `(t_a, origin + t_a dir, split)` with `t_a` the
+/// parameter of the point nearest the world origin, or `(0, origin, ..)` when that point is not
+/// ahead (`t_a <= 0`); `split` is [`Ray::anchor_split`].
 ///
 /// Computed in f64 and rounded once: `t_a` to f32 first, then the point at that very `t_a`, so the
 /// anchor lies on the ray to the rounding of its own coordinates (in f32 `origin + t_a dir` would
 /// be off the line by the rounding of the origin's coordinates, the error the anchor removes).
-fn anchor_of(origin: Vec3, dir: Vec3) -> (f32, Vec3) {
+fn anchor_of(origin: Vec3, dir: Vec3) -> (f32, Vec3, f32) {
     let o = origin.to_array().map(f64::from);
     let d = dir.to_array().map(f64::from);
     let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     // For a finite, non-zero `d`, `d . d` is positive and finite in f64 (as are all these
     // products of f32 values); the quotient can still exceed f32's range along a tiny direction,
     // where the anchor would not be a point: then, as for NaN from a bad ray, there is none.
-    let t = (-dot(o, d) / dot(d, d)) as f32;
+    let (od, dd) = (dot(o, d), dot(d, d));
+    let t = (-od / dd) as f32;
     if !(t > 0.0 && t.is_finite()) {
-        return (0.0, origin);
+        return (0.0, origin, od as f32);
     }
     let at = |k: usize| (o[k] + d[k] * f64::from(t)) as f32;
-    (t, Vec3::new(at(0), at(1), at(2)))
+    let split = od + f64::from(t) * dd * 0.5;
+    (t, Vec3::new(at(0), at(1), at(2)), split as f32)
 }
 
 impl Ray {
@@ -109,7 +115,7 @@ impl Ray {
     pub(crate) fn unchecked(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
         // `-0.0 + 0.0 == +0.0`: canonical zero components give `+inf` inverses.
         let canonical = dir + Vec3::ZERO;
-        let (anchor_t, anchor) = anchor_of(origin, dir);
+        let (anchor_t, anchor, anchor_split) = anchor_of(origin, dir);
         Self {
             origin,
             dir,
@@ -118,20 +124,32 @@ impl Ray {
             t_max,
             anchor,
             anchor_t,
+            anchor_split,
         }
     }
 
-    /// Where the triangle tests measure from: the point of the ray's line nearest the world
-    /// origin, when it lies ahead of the origin, and its ray parameter; else the origin and 0.
+    /// True when `p` is nearer the ray's anchor than its origin: `|p - a|^2 < |p - o|^2` with
+    /// `a = o + t_a d` is `dot(p - o, d) > t_a |d|^2 / 2`, so one dot product against a split
+    /// fixed per ray decides it. The triangle tests measure from the nearer of the two.
+    #[inline(always)]
+    pub(crate) fn anchor_is_nearer(&self, p: Vec3) -> bool {
+        p.dot(self.dir) > self.anchor_split
+    }
+
+    /// The ray's second point to measure triangles from, and its ray parameter: the point of
+    /// its line nearest the world origin when that lies ahead of the origin, else the origin
+    /// and 0.
     ///
     /// Moller-Trumbore's edge decisions carry an f32 error proportional to the distance between
     /// the point it measures from and the triangle. Measured from the origin, a ray from 1e8
     /// units away decides within 8 units of a 12-unit triangle's edges: noise. The anchor is
     /// never farther from the world origin than any point of the ray ahead of it, hits included,
     /// so measured from it the error is that of the scene's own coordinates, wherever the ray
-    /// starts. The hit's `t` is the anchor's plus the test's own. The anchor depends on the
-    /// origin and the direction alone, so every structure and the brute-force oracle, given the
-    /// same ray (or a segment of it), decide alike.
+    /// starts. A ray started near a triangle is better measured from its origin, so each
+    /// triangle test measures from whichever of the two is nearer the triangle's first vertex,
+    /// and a hit's `t` is that point's plus the test's own. Both depend on the origin and the
+    /// direction alone, so every structure and the brute-force oracle, given the same ray (or a
+    /// segment of it), decide alike.
     #[inline]
     pub fn anchor(&self) -> (f32, Vec3) {
         (self.anchor_t, self.anchor)

@@ -42,13 +42,15 @@ pub struct Hits4 {
     pub v: [f32; 4],
 }
 
-/// A ray's anchor and direction splatted over four lanes, and the direction itself for the
+/// A ray's origin, anchor and direction splatted over four lanes, and the direction itself for the
 /// determinant check, prepared once per ray.
 #[derive(Clone, Copy, Debug)]
 pub struct RayTri4 {
-    /// The ray's anchor ([`Ray::anchor`]), where the test measures from.
+    /// The ray's origin and anchor ([`Ray::anchor`]): the test measures from the nearer.
+    origin: [f32x4; 3],
     anchor: [f32x4; 3],
     anchor_t: f32x4,
+    anchor_split: f32x4,
     dir: [f32x4; 3],
     dir3: Vec3,
     t_min: f32x4,
@@ -60,8 +62,10 @@ impl RayTri4 {
     pub fn new(ray: &Ray) -> Self {
         let s = f32x4::splat;
         Self {
+            origin: [s(ray.origin.x), s(ray.origin.y), s(ray.origin.z)],
             anchor: [s(ray.anchor.x), s(ray.anchor.y), s(ray.anchor.z)],
             anchor_t: s(ray.anchor_t),
+            anchor_split: s(ray.anchor_split),
             dir: [s(ray.dir.x), s(ray.dir.y), s(ray.dir.z)],
             dir3: ray.dir,
             t_min: s(ray.t_min),
@@ -129,15 +133,15 @@ impl Triangle4 {
         let p = cross(ray.dir, e2);
         let det = dot(e1, p);
         let inv_det = f32x4::ONE / det;
-        let s = [
-            ray.anchor[0] - v0[0],
-            ray.anchor[1] - v0[1],
-            ray.anchor[2] - v0[2],
-        ];
+        // `Ray::anchor_is_nearer`, lane by lane.
+        let anchored = dot(v0, ray.dir).simd_gt(ray.anchor_split);
+        let s: [f32x4; 3] =
+            core::array::from_fn(|k| anchored.select(ray.anchor[k], ray.origin[k]) - v0[k]);
+        let t0 = anchored.select(ray.anchor_t, f32x4::ZERO);
         let u = dot(s, p) * inv_det;
         let q = cross(s, e1);
         let v = dot(ray.dir, q) * inv_det;
-        let t = ray.anchor_t + dot(e2, q) * inv_det;
+        let t = t0 + dot(e2, q) * inv_det;
         let zero = f32x4::ZERO;
         let one = f32x4::ONE;
         // Each comparison is false for NaN, as in the scalar test.

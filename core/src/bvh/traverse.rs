@@ -376,8 +376,9 @@ mod tests {
     /// Rays from 1e3 to 1e10 units away, aimed at triangles (in f32 a ray from 1e10 units can
     /// only aim to within about 600 units, so most of those miss): where exact arithmetic on the
     /// rays' own values leaves no hit within 1e-4 of an edge, the closest hit is exact
-    /// arithmetic's, and the binary and the 4-wide tree give brute force's answer, so their box
-    /// tests from far origins cull nothing the anchored triangle test hits (`Ray::anchor`).
+    /// arithmetic's (to `t`'s resolution), and the binary and the 4-wide tree give brute force's
+    /// answer, so their box tests from far origins cull nothing the triangle test, measured from
+    /// the ray's anchor there (`Ray::anchor`), hits.
     #[test]
     fn far_rays_answer_as_exact_arithmetic() {
         // Miri runs a small scene and a few rays.

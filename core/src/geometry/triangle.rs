@@ -118,11 +118,12 @@ impl Triangle {
     ///   every comparison rejects NaN, and the determinant and `t` must be finite, so overflow
     ///   cannot produce a hit either.
     ///
-    /// The arithmetic is f32, measured from the ray's anchor ([`Ray::anchor`]): `u` and `v`
-    /// carry an absolute error of about 2^-24 times the anchor's distance from the triangle over
-    /// the triangle's size. The anchor is never farther from the world origin than the hit, so
-    /// that distance is at most the scene's own extent from the world origin, wherever the ray
-    /// starts; the README's Known limits give the numbers.
+    /// The arithmetic is f32, measured from the ray's origin or its anchor ([`Ray::anchor`]),
+    /// whichever is nearer the triangle's first vertex: `u` and `v` carry an absolute error of
+    /// about 2^-24 times that distance over the triangle's size. The anchor is never farther
+    /// from the world origin than a hit ahead of the origin, so that distance is at most about
+    /// twice the hit's own distance from the world origin, wherever the ray starts; the README's
+    /// Known limits give the numbers.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<TriangleHit> {
         let e1 = self.v1 - self.v0;
@@ -317,10 +318,11 @@ mod tests {
 
     /// Found by black-box testing: measured from the origin, a ray from 1e8 units away hit a
     /// 12-unit triangle at `u = v = 0` while passing 3 units beside it. Rays from 1e3 to 1e10
-    /// units away (measured from the anchor; further out the f64 reference itself loses 1e-4), and rays started within a few units of 1-unit
-    /// triangles 4e5 units from the world origin (measured from the origin, which is nearer than
-    /// the anchor there), decide like exact arithmetic on their own f32 values, except within
-    /// 1e-4 of the triangle's size of an edge; scalar and 4-wide alike.
+    /// units away (measured from the anchor; further out the f64 reference itself loses 1e-4),
+    /// and rays started within a few units of 1-unit triangles 4e5 units from the world origin
+    /// (measured from the origin, which is nearer than the anchor there), decide like exact
+    /// arithmetic on their own f32 values, except within 1e-4 of the triangle's size of an
+    /// edge; scalar and 4-wide alike.
     #[test]
     fn far_origins_and_far_scenes_decide_like_exact_arithmetic() {
         use crate::geometry::{RayTri4, Triangle4};

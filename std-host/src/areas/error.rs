@@ -62,6 +62,16 @@ pub enum AreasErrorKind {
     },
     /// The values do not make an area (as `rdbvh-core` decided; the message names the key).
     Invalid(AreaError),
+    /// [`AreasErrorKind::Invalid`] for a number that single precision, in which areas are made,
+    /// reads as another value than the file wrote (`fov_x_deg = 179.99999999` reads as 180).
+    InvalidAsRead {
+        /// Why the area is invalid.
+        error: AreaError,
+        /// The number as the file wrote it.
+        written: String,
+        /// The number as read.
+        read: f32,
+    },
     /// An experiments file (`[[config]]` tables) has no entry for the scene.
     NoneForScene {
         /// The scene's name.
@@ -150,6 +160,15 @@ impl fmt::Display for AreasErrorKind {
                 area_kind.keys().join(", ")
             ),
             AreasErrorKind::Invalid(e) => e.fmt(f),
+            AreasErrorKind::InvalidAsRead {
+                error,
+                written,
+                read,
+            } => write!(
+                f,
+                "{error}; {} reads as {read} in single precision",
+                written.escape_debug()
+            ),
             AreasErrorKind::NoneForScene { scene, files } => {
                 write!(
                     f,

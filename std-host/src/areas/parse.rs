@@ -201,7 +201,15 @@ impl Entry<'_> {
         }
         .map_err(|e| {
             let value = area_error_key(&e).and_then(|k| self.table.get_ref().get(k));
-            self.error(value, AreasErrorKind::Invalid(e))
+            let kind = match value.and_then(|v| read_otherwise(self.text, v)) {
+                Some((written, read)) => AreasErrorKind::InvalidAsRead {
+                    error: e,
+                    written,
+                    read,
+                },
+                None => AreasErrorKind::Invalid(e),
+            };
+            self.error(value, kind)
         })?;
         Ok(AreaEntry {
             area,
@@ -282,6 +290,22 @@ fn as_f32(v: &Value) -> Option<f32> {
         Value::Float(f) => Some(*f as f32),
         _ => None,
     }
+}
+
+/// A number that single precision reads as another value than the file wrote, as `(written,
+/// read)`: an invalid area's message then says so, since the written value may look valid.
+fn read_otherwise(text: &str, value: &Spanned<Value>) -> Option<(String, f32)> {
+    let read = as_f32(value.get_ref())?;
+    let exact = match value.get_ref() {
+        Value::Integer(i) => i.to_string(),
+        Value::Float(f) => f.to_string(),
+        _ => return None,
+    };
+    if read.to_string() == exact {
+        return None;
+    }
+    let written = text.get(value.span())?.trim();
+    Some((written.to_string(), read))
 }
 
 /// What a value is, for "must be X, not Y".
@@ -552,12 +576,22 @@ mod tests {
                 "center = [inf, 0, 0]",
                 "`center` must be finite",
             ),
-            ("depth = 20.0", "depth = 1e300", "`depth` must be finite"),
+            (
+                "depth = 20.0",
+                "depth = 1e300",
+                "`depth` must be finite (got NaN or infinity); 1e300 reads as inf in single precision",
+            ),
         ] {
             let text = format!("[[area]]\n{}", PLANE.replace(from, to));
             assert_ne!(text, format!("[[area]]\n{PLANE}"), "{from}");
             let e = error(&text);
-            assert!(matches!(e.kind, AreasErrorKind::Invalid(_)), "{e}");
+            assert!(
+                matches!(
+                    e.kind,
+                    AreasErrorKind::Invalid(_) | AreasErrorKind::InvalidAsRead { .. }
+                ),
+                "{e}"
+            );
             let s = e.to_string();
             assert!(s.contains(needle), "{s}");
             let line = text.lines().position(|l| l == to).unwrap() + 1;
@@ -567,7 +601,14 @@ mod tests {
             (
                 "fov_x_deg = 60.0",
                 "fov_x_deg = 180",
-                "`fov_x_deg` must be strictly between",
+                "`fov_x_deg` must be strictly between 0 and 180 degrees",
+            ),
+            // Below 180 as written, 180 as read: the message says why it is refused.
+            (
+                "fov_x_deg = 60.0",
+                "fov_x_deg = 179.99999999",
+                "`fov_x_deg` must be strictly between 0 and 180 degrees; 179.99999999 reads as 180 \
+                 in single precision",
             ),
             (
                 "fov_y_deg = 45",

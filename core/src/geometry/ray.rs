@@ -59,7 +59,8 @@ pub struct Ray {
     /// The ray parameter of [`Ray::anchor`] (0 when the anchor is the origin).
     pub(crate) anchor_t: f32,
     /// `dot(origin, dir) + anchor_t |dir|^2 / 2`: a point `p` is nearer the anchor than the
-    /// origin exactly when `dot(p, dir)` exceeds it (see [`Ray::anchor_is_nearer`]).
+    /// origin when `dot(p, dir)` exceeds it (see [`Ray::anchor_is_nearer`]; rounding matters only
+    /// where the two are about as near).
     pub(crate) anchor_split: f32,
 }
 

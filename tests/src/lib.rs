@@ -150,7 +150,8 @@ pub fn known_core_bug(ray: &Ray, tris: &[Triangle]) -> Option<&'static str> {
         // The hit must pass the box test of the triangle's own padded box (as BVH nodes store
         // it) at that very `t`; then it passes every enclosing node's too. An ill-conditioned
         // Moller-Trumbore `t` (a ray nearly in the triangle's plane, or a tiny triangle far from
-        // the ray's anchor) can put the hit point far outside, where no BVH can find it.
+        // both the ray's origin and its anchor) can put the hit point far outside, where no BVH
+        // can find it.
         let at_hit = Ray::segment(ray.origin, ray.dir, h.t, h.t).ok()?;
         tri.bounds()
             .padded()

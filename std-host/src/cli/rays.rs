@@ -273,32 +273,38 @@ fn read_rows<R: Read>(
 
 /// The ray of one row, or what is wrong with it.
 fn ray_of(record: &csv::StringRecord, columns: &Columns) -> Result<Ray, String> {
-    let field = |i: usize, name: &str| -> Result<Option<f32>, String> {
+    // `finite`: the column must hold a finite number, so a finite one past f32's range (read
+    // as infinity, which the ray would refuse as if the file had written one) is named as such.
+    let field = |i: usize, name: &str, finite: bool| -> Result<Option<f32>, String> {
         let text = record.get(i).unwrap_or("").trim();
         if text.is_empty() {
             return Ok(None);
         }
-        text.parse::<f32>().map(Some).map_err(|_| {
-            // Echoed escaped and cut short: a quoted cell may hold newlines or a whole file.
-            let shown: String = text.chars().take(40).collect();
-            let more = if text.chars().count() > 40 { "..." } else { "" };
-            format!(
-                "column '{name}': cannot parse '{}{more}' as a number",
-                shown.escape_debug()
-            )
-        })
+        // Echoed escaped and cut short: a quoted cell may hold newlines or a whole file.
+        let cut: String = text.chars().take(40).collect();
+        let more = if text.chars().count() > 40 { "..." } else { "" };
+        let shown = format!("{}{more}", cut.escape_debug());
+        let value = text
+            .parse::<f32>()
+            .map_err(|_| format!("column '{name}': cannot parse '{shown}' as a number"))?;
+        if finite && value.is_infinite() && !text.to_ascii_lowercase().contains("inf") {
+            return Err(format!(
+                "column '{name}': {shown} is beyond single precision's range (about 3.4e38)"
+            ));
+        }
+        Ok(Some(value))
     };
     let mut v = [0.0f32; 6];
     for ((value, &i), name) in v.iter_mut().zip(&columns.required).zip(REQUIRED_COLUMNS) {
-        *value = field(i, name)?.ok_or_else(|| format!("column '{name}' is empty"))?;
+        *value = field(i, name, true)?.ok_or_else(|| format!("column '{name}' is empty"))?;
     }
     // An empty tmin/tmax cell means the default, like a missing column.
     let t_min = match columns.tmin {
-        Some(i) => field(i, "tmin")?.unwrap_or(0.0),
+        Some(i) => field(i, "tmin", false)?.unwrap_or(0.0),
         None => 0.0,
     };
     let t_max = match columns.tmax {
-        Some(i) => field(i, "tmax")?.unwrap_or(f32::INFINITY),
+        Some(i) => field(i, "tmax", false)?.unwrap_or(f32::INFINITY),
         None => f32::INFINITY,
     };
     let origin = Vec3::new(v[0], v[1], v[2]);
@@ -374,6 +380,14 @@ mod tests {
     }
 
     #[test]
+    fn segment_ends_past_f32_range_read_as_infinite() {
+        // Unlike an origin or a direction, a segment end may be infinite: past f32's range it
+        // is, as far as the ray goes anyway.
+        let rays = parse("ox,oy,oz,dx,dy,dz,tmin,tmax\n0,0,0,1,0,0,0,1e39\n").unwrap();
+        assert_eq!(rays[0].t_max, f32::INFINITY);
+    }
+
+    #[test]
     fn header_only_is_no_rays() {
         assert!(parse("ox,oy,oz,dx,dy,dz\n").unwrap().is_empty());
     }
@@ -387,6 +401,11 @@ mod tests {
             ("nan,0,0,1,0,0,0,1\n", "NaN"),
             ("0,0,0,1,0,0,nan,1\n", "NaN"),
             ("inf,0,0,1,0,0,0,1\n", "infinite"),
+            (
+                "1e39,0,0,1,0,0,0,1\n",
+                "column 'ox': 1e39 is beyond single precision's range",
+            ),
+            ("0,0,0,-4e38,0,0,0,1\n", "column 'dx': -4e38 is beyond"),
             ("0,0,0,1,x,0,0,1\n", "cannot parse"),
             ("0,0,0,1,0,0,0\n", "fields"),
             ("0,0,,1,0,0,0,1\n", "empty"),

@@ -1,6 +1,7 @@
 //! Flat binary BVHs: node arrays with adjacent children, a primitive-index array, and the maximum
 //! depth recorded at build time so that traversal stacks are provably large enough.
 
+mod collapse;
 mod node;
 mod traversable;
 mod traverse;

@@ -5,6 +5,7 @@ use alloc::vec::Vec;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
+use super::collapse::{CollapsePlan, LEAF_BLOCK};
 use super::{Bvh, BvhNode, MAX_DEPTH};
 use crate::geometry::{Aabb, Triangle, Triangle4};
 
@@ -64,19 +65,6 @@ impl WideNode {
     }
 }
 
-/// Largest binary subtree the collapse may turn into one leaf (two [`Triangle4`] blocks). One of
-/// five to eight triangles becomes a leaf of two blocks when splitting it would save little (see
-/// [`MERGE_RATIO`]); one of at most [`WideBvh::ONE_BLOCK`] always becomes a leaf.
-const LEAF_BLOCK: usize = 8;
-
-/// A subtree of five to eight triangles becomes one leaf when its children, weighted by their
-/// surface areas (the chance a ray entering the subtree enters them), would still cost at least
-/// this share of the leaf's block tests. Fewer, larger leaves mean fewer nodes and fewer cache
-/// misses: on the bunny (small, uniform triangles, tight leaves) 0.5 raised closest_random by
-/// about 10% over four-triangle leaves, while on Sponza (long triangles) merging every such
-/// subtree lost 5% on random rays and 0.5 loses nothing.
-const MERGE_RATIO: f32 = 0.5;
-
 /// A 4-wide BVH with its own copy of the triangles, in leaf order and laid out for the 4-wide
 /// triangle test ([`Triangle4`] blocks: a leaf tests four triangles per step, with no indirection
 /// through a primitive-index array). The root is node 0; a BVH whose binary root becomes a leaf
@@ -96,12 +84,13 @@ impl WideBvh {
     /// need not split such nodes ([`crate::build::Builder::for_wide`]).
     pub const ONE_BLOCK: u32 = 4;
 
-    /// Collapses a binary BVH built over `tris`: each wide node takes a binary node's children and
-    /// keeps opening the inner child of largest surface area (the one a ray is likeliest to enter)
-    /// until it has four. A binary subtree of at most four triangles becomes one leaf of one
-    /// [`Triangle4`] block, one of five to eight a leaf of two blocks when the merge ratio
-    /// (`MERGE_RATIO`, 0.5) says splitting it saves little, and a larger binary leaf a leaf of
-    /// consecutive blocks. Depth never grows. Ids missing from `tris` are dropped, as the binary traversal skips them.
+    /// Collapses a binary BVH built over `tris` into the 4-wide tree of least SAH cost that keeps
+    /// its subtrees ([`CollapsePlan`]): each wide node stands for a binary node and takes two to
+    /// four of its descendants as slots, chosen by dynamic programming over the binary tree. A
+    /// binary subtree of at most four triangles becomes one leaf of one [`Triangle4`] block, one
+    /// of five to eight a leaf of two blocks when that costs less than opening it, and a larger
+    /// binary leaf a leaf of consecutive blocks. Depth never grows. Ids missing from `tris` are
+    /// dropped, as the binary traversal skips them.
     pub fn from_binary(bvh: &Bvh, tris: &[Triangle]) -> Self {
         let mut out = WideBvh {
             nodes: Vec::with_capacity(bvh.nodes.len() / 4 + 1),
@@ -113,9 +102,8 @@ impl WideBvh {
             return out;
         }
         out.nodes.push(WideNode::UNUSED);
-        let sizes = subtree_sizes(bvh);
-        let is_wide_leaf = |b: u32| is_wide_leaf(bvh, &sizes, b);
-        if is_wide_leaf(0) {
+        let plan = CollapsePlan::new(bvh);
+        if plan.root_is_leaf(bvh) {
             out.push_leaf(0, 0, bvh, 0, tris);
             return out;
         }
@@ -124,26 +112,9 @@ impl WideBvh {
         stack.push((0, 0, 0));
         while let Some((wide, binary, depth)) = stack.pop() {
             out.max_depth = out.max_depth.max(depth);
-            // Binary nodes standing for the wide node's slots, with whether each is a wide leaf.
-            let mut open: [(u32, bool); 4] = [(0, false); 4];
-            let node = &bvh.nodes[binary as usize];
-            for (i, slot) in open[..2].iter_mut().enumerate() {
-                let b = node.left_first + i as u32;
-                *slot = (b, is_wide_leaf(b));
-            }
-            let mut n = 2;
-            while n < 4 {
-                let pick = (0..n).filter(|&i| !open[i].1).max_by(|&a, &b| {
-                    let area = |i: usize| bvh.nodes[open[i].0 as usize].bounds().half_area();
-                    area(a).total_cmp(&area(b))
-                });
-                let Some(i) = pick else { break };
-                let l = bvh.nodes[open[i].0 as usize].left_first;
-                open[i] = (l, is_wide_leaf(l));
-                open[n] = (l + 1, is_wide_leaf(l + 1));
-                n += 1;
-            }
-            for (slot, &(b, leaf)) in open[..n].iter().enumerate() {
+            let mut slots = [(0u32, false); 4];
+            let n = plan.slots(bvh, binary, &mut slots);
+            for (slot, &(b, leaf)) in slots[..n].iter().enumerate() {
                 if leaf {
                     out.push_leaf(wide, slot, bvh, b, tris);
                 } else {
@@ -216,57 +187,6 @@ impl WideBvh {
         self.nodes.len() * core::mem::size_of::<WideNode>()
             + self.tris.len() * core::mem::size_of::<Triangle4>()
     }
-}
-
-/// Primitives in each binary node's subtree, saturated at `LEAF_BLOCK + 1` ("more than a
-/// leaf's two blocks"): one post-order pass, so deciding whether a node becomes a wide leaf
-/// costs a lookup instead of a walk of its subtree (the collapse asks it of every node it opens,
-/// and each answer's merge ratio asks it of both children again).
-fn subtree_sizes(bvh: &Bvh) -> Vec<u8> {
-    const MORE: u8 = LEAF_BLOCK as u8 + 1;
-    let mut sizes = alloc::vec![0u8; bvh.nodes.len()];
-    // (node, whether its children are done); a valid tree's depth bounds the stack.
-    let mut stack: Vec<(u32, bool)> = Vec::with_capacity(2 * MAX_DEPTH as usize + 2);
-    stack.push((0, false));
-    while let Some((b, done)) = stack.pop() {
-        let node = &bvh.nodes[b as usize];
-        if node.is_leaf() {
-            sizes[b as usize] = node.count.min(u32::from(MORE)) as u8;
-        } else if done {
-            let l = node.left_first as usize;
-            sizes[b as usize] = (sizes[l] + sizes[l + 1]).min(MORE);
-        } else {
-            stack.push((b, true));
-            stack.push((node.left_first + 1, false));
-            stack.push((node.left_first, false));
-        }
-    }
-    sizes
-}
-
-/// True when binary node `b` becomes a leaf of the wide tree: a binary leaf, a subtree of at most
-/// [`WideBvh::ONE_BLOCK`] triangles, or one of at most [`LEAF_BLOCK`] that [`MERGE_RATIO`] says
-/// not to split. `sizes` is [`subtree_sizes`]'s.
-fn is_wide_leaf(bvh: &Bvh, sizes: &[u8], b: u32) -> bool {
-    let node = &bvh.nodes[b as usize];
-    if node.is_leaf() {
-        return true;
-    }
-    let n = usize::from(sizes[b as usize]);
-    if n > LEAF_BLOCK {
-        return false;
-    }
-    if n <= WideBvh::ONE_BLOCK as usize {
-        return true;
-    }
-    // Blocks a ray entering child `c` tests, weighted by the chance that it enters (a child of
-    // a subtree of at most LEAF_BLOCK primitives holds at most that many itself).
-    let blocks = |c: u32| {
-        usize::from(sizes[c as usize]).div_ceil(4) as f32
-            * bvh.nodes[c as usize].bounds().half_area()
-    };
-    let l = node.left_first;
-    blocks(l) + blocks(l + 1) >= MERGE_RATIO * n.div_ceil(4) as f32 * node.bounds().half_area()
 }
 
 /// The primitive ids of binary subtree `b` when it is a leaf of at most [`LEAF_BLOCK`] primitives

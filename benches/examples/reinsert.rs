@@ -149,6 +149,16 @@ fn run(scene: &str, for_wide: bool, configs: &[(f32, u32)]) -> Result<(), String
 
     let views = views(&b);
     let base_costs: Vec<f64> = views.iter().map(|(_, r)| view_cost(&wides[0], r)).collect();
+    let each: Vec<String> = views
+        .iter()
+        .zip(&base_costs)
+        .map(|((v, _), c)| format!("{v} {c:.2}"))
+        .collect();
+    let geo = (base_costs.iter().map(|c| c.ln()).sum::<f64>() / base_costs.len() as f64).exp();
+    println!(
+        "  the build's traversal cost per ray: geometric mean {geo:.3} ({})",
+        each.join(", ")
+    );
     println!("  traversal cost over the views, as a ratio to the build's:");
     for ((name, _), wide) in trees.iter().zip(&wides).skip(1) {
         let ratios: Vec<f64> = views

@@ -85,12 +85,12 @@ impl WideBvh {
     pub const ONE_BLOCK: u32 = 4;
 
     /// Collapses a binary BVH built over `tris` into the 4-wide tree of least SAH cost that keeps
-    /// its subtrees ([`CollapsePlan`]): each wide node stands for a binary node and takes two to
-    /// four of its descendants as slots, chosen by dynamic programming over the binary tree. A
-    /// binary subtree of at most four triangles becomes one leaf of one [`Triangle4`] block, one
-    /// of five to eight a leaf of two blocks when that costs less than opening it, and a larger
-    /// binary leaf a leaf of consecutive blocks. Depth never grows. Ids missing from `tris` are
-    /// dropped, as the binary traversal skips them.
+    /// its subtrees (node and block tests priced alike; `core/src/bvh/collapse.rs`): each wide
+    /// node stands for a binary node and takes two to four of its descendants as slots, chosen by
+    /// dynamic programming over the binary tree. A binary subtree of at most four triangles
+    /// becomes one leaf of one [`Triangle4`] block, one of five to eight a leaf of two blocks when
+    /// that costs less than opening it, and a larger binary leaf a leaf of consecutive blocks.
+    /// Depth never grows. Ids missing from `tris` are dropped, as the binary traversal skips them.
     pub fn from_binary(bvh: &Bvh, tris: &[Triangle]) -> Self {
         let mut out = WideBvh {
             nodes: Vec::with_capacity(bvh.nodes.len() / 4 + 1),

@@ -67,8 +67,8 @@ impl CollapsePlan {
         stack.push((0, false));
         while let Some((b, done)) = stack.pop() {
             let node = &bvh.nodes[b as usize];
-            let area = node.bounds().half_area();
             if node.is_leaf() {
+                let area = node.bounds().half_area();
                 // A binary leaf is a wide leaf, in as many blocks as it needs.
                 size[b as usize] = node.count.min(u32::from(MORE)) as u8;
                 cost[b as usize] = [area * C_BLOCK * node.count.div_ceil(4) as f32; 4];
@@ -86,6 +86,7 @@ impl CollapsePlan {
                 stack.push((l as u32, false));
                 continue;
             }
+            let area = node.bounds().half_area();
             let s = (size[l] + size[l + 1]).min(MORE);
             size[b as usize] = s;
             // shared[j - 2]: the children's cheapest split of `j` slots, and the left's share.

@@ -74,6 +74,17 @@ fn view_cost(wide: &WideBvh, rays: &[Ray]) -> f64 {
     (f64::from(s.inner_nodes) + f64::from(s.triangles) / 4.0) / rays.len().max(1) as f64
 }
 
+/// `values` (one per view) as their geometric mean, then each with its view's name.
+fn per_view(views: &[(String, Vec<Ray>)], values: &[f64]) -> String {
+    let geo = (values.iter().map(|v| v.ln()).sum::<f64>() / values.len() as f64).exp();
+    let each: Vec<String> = views
+        .iter()
+        .zip(values)
+        .map(|((v, _), x)| format!("{v} {x:.2}"))
+        .collect();
+    format!("geometric mean {geo:.3} ({})", each.join(", "))
+}
+
 /// Mrays/s of closest-hit queries over `rays`, thread CPU time; the hits' distances for checking.
 fn trace(wide: &WideBvh, rays: &[Ray]) -> (f64, Vec<Option<f32>>) {
     let t = thread_cpu_seconds();
@@ -149,15 +160,9 @@ fn run(scene: &str, for_wide: bool, configs: &[(f32, u32)]) -> Result<(), String
 
     let views = views(&b);
     let base_costs: Vec<f64> = views.iter().map(|(_, r)| view_cost(&wides[0], r)).collect();
-    let each: Vec<String> = views
-        .iter()
-        .zip(&base_costs)
-        .map(|((v, _), c)| format!("{v} {c:.2}"))
-        .collect();
-    let geo = (base_costs.iter().map(|c| c.ln()).sum::<f64>() / base_costs.len() as f64).exp();
     println!(
-        "  the build's traversal cost per ray: geometric mean {geo:.3} ({})",
-        each.join(", ")
+        "  the build's traversal cost per ray: {}",
+        per_view(&views, &base_costs)
     );
     println!("  traversal cost over the views, as a ratio to the build's:");
     for ((name, _), wide) in trees.iter().zip(&wides).skip(1) {
@@ -166,13 +171,7 @@ fn run(scene: &str, for_wide: bool, configs: &[(f32, u32)]) -> Result<(), String
             .zip(&base_costs)
             .map(|((_, r), c0)| view_cost(wide, r) / c0)
             .collect();
-        let geo = (ratios.iter().map(|r| r.ln()).sum::<f64>() / ratios.len() as f64).exp();
-        let each: Vec<String> = views
-            .iter()
-            .zip(&ratios)
-            .map(|((v, _), r)| format!("{v} {r:.2}"))
-            .collect();
-        println!("  {name}: geometric mean {geo:.3} ({})", each.join(", "));
+        println!("  {name}: {}", per_view(&views, &ratios));
     }
 
     for kind in [RayKind::Camera, RayKind::Random] {

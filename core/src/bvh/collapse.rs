@@ -50,8 +50,8 @@ struct Choice {
 /// The collapse's decisions for every node of a binary BVH.
 pub(crate) struct CollapsePlan {
     choice: Vec<Choice>,
-    /// Subtree sizes, saturated at [`MORE`].
-    size: Vec<u8>,
+    /// The binary root is a leaf or holds at most [`super::WideBvh::ONE_BLOCK`] triangles.
+    root_forced: bool,
 }
 
 impl CollapsePlan {
@@ -124,15 +124,19 @@ impl CollapsePlan {
                 left: shared.map(|(_, k)| k),
             };
         }
-        Self { choice, size }
+        let root_forced = bvh.nodes[0].is_leaf() || u32::from(size[0]) <= super::WideBvh::ONE_BLOCK;
+        Self {
+            choice,
+            root_forced,
+        }
     }
 
     /// True when the binary root becomes the wide root's only child, a leaf: when it is a binary
     /// leaf or holds at most [`super::WideBvh::ONE_BLOCK`] triangles. A root of five to eight
     /// opens, whatever it would cost as a leaf in a slot: the wide root is entered anyway, and
     /// its children's leaves cost at most the two blocks of one leaf over the root's box.
-    pub(crate) fn root_is_leaf(&self, bvh: &Bvh) -> bool {
-        bvh.nodes[0].is_leaf() || u32::from(self.size[0]) <= super::WideBvh::ONE_BLOCK
+    pub(crate) fn root_is_leaf(&self) -> bool {
+        self.root_forced
     }
 
     /// The slots of the wide node standing for binary inner node `b` (one that is not a leaf):

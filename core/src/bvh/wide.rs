@@ -103,7 +103,7 @@ impl WideBvh {
         }
         out.nodes.push(WideNode::UNUSED);
         let plan = CollapsePlan::new(bvh);
-        if plan.root_is_leaf(bvh) {
+        if plan.root_is_leaf() {
             out.push_leaf(0, 0, bvh, 0, tris);
             return out;
         }

@@ -119,18 +119,20 @@ else
     echo "FUZZ_SECONDS=0: fuzzing skipped"
 fi
 
-section "miri (rdbvh-core unit tests: geometry, simd, traversal stacks)"
+section "miri (rdbvh-core unit tests: geometry, simd, traversal stacks, graft)"
 # Miri needs a nightly toolchain with the miri component; where rustup has (or can add) them, the
-# core's geometry, SIMD and traversal-stack unit tests run under it: the core's one unsafe block
-# (the traversal stack's read of an initialised slot) and the unsafe code of its dependencies
-# (wide, bytemuck, glam) as the core uses them. It interprets a
+# core's geometry, SIMD and traversal-stack unit tests and a small graft run under it: two of the
+# core's unsafe blocks (the traversal stack's read of an initialised slot, the graft's declaring
+# every node of the new tree written) and the unsafe code of its dependencies (wide, bytemuck,
+# glam) as the core uses them. It interprets a
 # big-endian target (s390x): on x86_64, libm's sqrtf is inline assembly, which Miri cannot run.
 # The rest of the unit tests trace up to 100k rays each, hours under Miri. MIRI=0 skips this;
 # without nightly it is a printed skip, not a failure, since the project builds on stable.
 if [[ ${MIRI:-1} != 0 ]] && rustup run nightly rustc --version >/dev/null 2>&1 \
     && rustup component add miri rust-src --toolchain nightly >/dev/null 2>&1; then
     cargo +nightly miri test -p rdbvh-core --lib --target s390x-unknown-linux-gnu \
-        -- geometry:: simd:: bvh::traverse:: 2>&1 | tee "$LOG_DIR/miri.log"
+        -- geometry:: simd:: bvh::traverse:: build::graft::tests::small_ 2>&1 \
+        | tee "$LOG_DIR/miri.log"
 else
     echo "miri skipped: no nightly toolchain with the miri component here (MIRI=${MIRI:-1})"
 fi

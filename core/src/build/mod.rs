@@ -19,7 +19,7 @@ pub use arena::{BuildArena, LoadedBounds, TriangleLoad};
 pub use binning::{BinJob, NodeBinner, NodeBins, SerialBinner};
 pub use builder::{BuildStats, Builder, Subtree, SubtreeSink};
 pub use config::{BinSpace, BuildConfig, CutEvaluation, ThesisCut, MAX_BINS, MAX_EXHAUSTIVE};
-pub use graft::GraftError;
+pub use graft::{GraftBlock, GraftError};
 pub use preset::{AreaPah, Preset, PresetError, PresetOptions, PresetVisitor};
 pub use profile::{Clock, NoClock, PhaseProfile};
 pub use reinsert::{reinsert, ReinsertConfig, ReinsertStats, Reinserter};

@@ -115,6 +115,16 @@ fn unordered(k: u32) -> f32 {
     f32::from_bits(if k >> 31 == 1 { k & !(1 << 31) } else { !k })
 }
 
+/// Buckets of [`bucket`]: a positive finite float's exponent and its top three mantissa bits.
+const BUCKETS: usize = 1 << 11;
+
+/// The bucket of a positive finite measure: buckets are in the measures' order (a positive
+/// float's bits are), so every measure in a higher bucket is larger.
+#[inline(always)]
+fn bucket(m: f32) -> usize {
+    (m.to_bits() >> 20) as usize & (BUCKETS - 1)
+}
+
 /// A node waiting in the branch-and-bound search: its induced cost's [`ordered`] bits above its
 /// index, so the min-heap pops the smallest induced cost first, ties to the lower index (the
 /// search is a function of the tree alone), with one integer comparison.
@@ -136,6 +146,8 @@ pub struct Reinserter {
     /// Measure's [`ordered`] bits above the complemented index: descending order is the largest
     /// measure first, ties to the lower index.
     candidates: Vec<u64>,
+    /// Nodes per [`bucket`] of measure, for [`Reinserter::pick`].
+    histogram: Vec<u32>,
     heap: BinaryHeap<Reverse<u64>>,
     path: Vec<u32>,
     nodes: Vec<BvhNode>,
@@ -246,23 +258,49 @@ impl Reinserter {
 
     /// The pass's candidates: the `fraction` largest nodes of positive measure (not the root),
     /// largest first, ties by index.
+    ///
+    /// A histogram of the measures' top bits finds the bucket the last candidate falls in, and
+    /// only the nodes from that bucket up are collected and ordered: the same nodes, in the same
+    /// order, as ordering them all. On Crytek Sponza (262k nodes) selecting among all of them
+    /// took a quarter of reinsertion's instructions.
     fn pick(&mut self, fraction: f32) {
         self.candidates.clear();
-        let root = self.root;
+        let root = self.root as usize;
+        // Positive and finite: the bits of (0, inf), one comparison.
+        let valid = |m: f32| m.to_bits().wrapping_sub(1) < f32::INFINITY.to_bits() - 1;
+        self.histogram.clear();
+        self.histogram.resize(BUCKETS, 0);
+        let mut count = 0usize;
+        for &m in &self.measure {
+            if valid(m) {
+                self.histogram[bucket(m)] += 1;
+                count += 1;
+            }
+        }
+        if let Some(&m) = self.measure.get(root).filter(|&&m| valid(m)) {
+            self.histogram[bucket(m)] -= 1;
+            count -= 1;
+        }
+        let keep = (libm::ceil(count as f64 * f64::from(fraction)) as usize).min(count);
+        if keep == 0 {
+            return;
+        }
+        // The highest bucket whose nodes and those above number at least `keep`.
+        let (mut lowest, mut above) = (BUCKETS - 1, 0usize);
+        for (b, &n) in self.histogram.iter().enumerate().rev() {
+            (lowest, above) = (b, above + n as usize);
+            if above >= keep {
+                break;
+            }
+        }
         self.candidates.extend(
             self.measure
                 .iter()
                 .enumerate()
-                .filter(|&(i, &m)| i as u32 != root && m > 0.0 && m.is_finite())
+                .filter(|&(i, &m)| valid(m) && bucket(m) >= lowest && i != root)
                 .map(|(i, &m)| u64::from(ordered(m)) << 32 | u64::from(u32::MAX - i as u32)),
         );
         let order = |a: &u64, b: &u64| b.cmp(a);
-        let keep = (libm::ceil(self.candidates.len() as f64 * f64::from(fraction)) as usize)
-            .min(self.candidates.len());
-        if keep == 0 {
-            self.candidates.clear();
-            return;
-        }
         if keep < self.candidates.len() {
             self.candidates.select_nth_unstable_by(keep - 1, order);
             self.candidates.truncate(keep);
@@ -656,6 +694,50 @@ mod tests {
             assert_eq!(bvh.bounds(), built.bounds());
             let (before, after) = (built.estimated_cost(&Sah, k), bvh.estimated_cost(&Sah, k));
             assert!(after <= before, "{stats:?}: {before} -> {after}");
+        }
+    }
+
+    #[test]
+    fn candidates_are_the_largest_nodes_in_order() {
+        // The order `pick` must give: every node of positive finite measure but the root, by
+        // measure descending, ties by index, the first `ceil(fraction * count)`.
+        fn reference(measure: &[f32], root: u32, fraction: f32) -> Vec<u32> {
+            let mut all: Vec<u32> = (0..measure.len() as u32)
+                .filter(|&i| i != root && measure[i as usize] > 0.0)
+                .filter(|&i| measure[i as usize].is_finite())
+                .collect();
+            all.sort_by(|&a, &b| {
+                let (ma, mb) = (measure[a as usize], measure[b as usize]);
+                mb.total_cmp(&ma).then(a.cmp(&b))
+            });
+            let keep = libm::ceil(all.len() as f64 * f64::from(fraction)) as usize;
+            all.truncate(keep);
+            all
+        }
+        let mut rng = Pcg32::new(9);
+        let mut r = Reinserter::new();
+        for round in 0..60 {
+            let n = [1, 2, 7, 100, 3000][round % 5];
+            r.measure = (0..n)
+                .map(|k| match (round / 5) % 4 {
+                    // Spread over many buckets, with a few repeats.
+                    0 => libm::powf(10.0, rng.range(-30.0, 30.0)),
+                    // All in one or two buckets: ties and a bucket holding everything.
+                    1 => 1.0 + (k % 3) as f32 * f32::EPSILON,
+                    2 => [0.0, f32::NAN, f32::INFINITY, 5.0, -1.0, 1e-42][k % 6],
+                    _ => rng.range(0.0, 2.0),
+                })
+                .collect();
+            r.root = (round as u32 * 7) % n as u32;
+            for fraction in [1e-6, 0.02, 0.3, 1.0] {
+                r.pick(fraction);
+                let got: Vec<u32> = r.candidates.iter().map(|&c| u32::MAX - c as u32).collect();
+                assert_eq!(
+                    got,
+                    reference(&r.measure, r.root, fraction),
+                    "{round} {fraction}"
+                );
+            }
         }
     }
 

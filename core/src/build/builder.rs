@@ -1,9 +1,10 @@
 //! The build skeleton: choose axes, bin, sweep, then stop or split. Heuristics are type parameters.
 
-use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRef, PrimRefs, Sweep, Task};
+use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRefs, Sweep, Task};
 use super::binning::{BinJob, NodeBinner, SerialBinner, BIN_BYTES};
 use super::config::{BinSpace, BuildConfig, CutEvaluation};
 use super::exhaustive::{cheapest_bipartition, partition_by_mask};
+use super::partition::{centroid_bounds, swap_misplaced};
 use super::profile::{Clock, NoClock, PhaseProfile};
 use crate::bvh::{Bvh, BvhNode, WideBvh};
 use alloc::vec::Vec;
@@ -997,12 +998,9 @@ const DUAL_BINNING_MIN: usize = 256;
 /// Nodes above this size partition by [`BinMap::threshold`].
 const THRESHOLD_MIN_COUNT: u32 = 16;
 
-/// [`partition`] with the classification `goes_left` of a doubled centroid coordinate.
-///
-/// Hoare's scheme over the shrinking slice of unclassified slots: only misplaced pairs are
-/// swapped, and slice patterns give the two ends of the slice without index bounds checks. The
-/// child centroid bounds are gathered in 4-wide lanes as each slot settles on its side (lane 3
-/// carries the id's halves and is dropped).
+/// [`partition`] with the classification `goes_left` of a doubled centroid coordinate: the first
+/// `n_left` slots take the left-goers ([`swap_misplaced`], Hoare's permutation without a branch
+/// per primitive), then each side's centroid bounds are gathered in a pass of its own.
 #[inline(always)]
 fn partition_by(
     arena: &mut BuildArena,
@@ -1010,49 +1008,15 @@ fn partition_by(
     split: &Split,
     goes_left: impl Fn(f32) -> bool,
 ) -> (Child, Child) {
-    let axis = split.axis;
-    let goes_left = |r: &PrimRef| goes_left(r.centroid2_axis(axis));
-    let inf = f32x4::splat(f32::INFINITY);
-    let (mut l_lo, mut l_hi, mut r_lo, mut r_hi) = (inf, -inf, inf, -inf);
-    let mut rest = arena
+    let (axis, cut) = (split.axis, &split.cut);
+    let slots = arena
         .refs
         .slots_mut(task.start as usize, task.count as usize);
-    let base = rest.as_ptr() as usize;
-    loop {
-        // Slots already on the left, from the front.
-        let mut k = 0;
-        while k < rest.len() && goes_left(&rest[k]) {
-            let c = rest[k].centroid2_4();
-            (l_lo, l_hi) = (l_lo.fast_min(c), l_hi.fast_max(c));
-            k += 1;
-        }
-        rest = &mut core::mem::take(&mut rest)[k..];
-        // Slots already on the right, from the back.
-        let mut m = rest.len();
-        while m > 0 && !goes_left(&rest[m - 1]) {
-            m -= 1;
-            let c = rest[m].centroid2_4();
-            (r_lo, r_hi) = (r_lo.fast_min(c), r_hi.fast_max(c));
-        }
-        rest = &mut core::mem::take(&mut rest)[..m];
-        // The first slot belongs right and the last left (one slot cannot be both): swap them.
-        let unsorted = core::mem::take(&mut rest);
-        let [first, middle @ .., last] = unsorted else {
-            rest = unsorted;
-            break;
-        };
-        core::mem::swap(first, last);
-        let (cl, cr) = (first.centroid2_4(), last.centroid2_4());
-        (l_lo, l_hi) = (l_lo.fast_min(cl), l_hi.fast_max(cl));
-        (r_lo, r_hi) = (r_lo.fast_min(cr), r_hi.fast_max(cr));
-        rest = middle;
-    }
-    let cut = &split.cut;
-    // The empty rest sits at the boundary between the children.
-    debug_assert_eq!(
-        (rest.as_ptr() as usize - base) / core::mem::size_of::<PrimRef>(),
-        cut.n_left as usize
-    );
+    let (front, back) = slots.split_at_mut(cut.n_left as usize);
+    let paired = swap_misplaced(front, back, |r| goes_left(r.centroid2_axis(axis)));
+    // The sweep counted the left-goers with the same classification.
+    debug_assert!(paired, "the partition disagrees with the bins");
+    let ((l_lo, l_hi), (r_lo, r_hi)) = (centroid_bounds(front), centroid_bounds(back));
     (
         (cut.left, cut.n_left, lanes_to_aabb(l_lo, l_hi)),
         (cut.right, cut.n_right, lanes_to_aabb(r_lo, r_hi)),

@@ -58,6 +58,11 @@ const ORDER: [[u8; SUBSETS / 2]; MAX_EXHAUSTIVE as usize + 1] = {
 /// whose hint is `hint`, and the mask of the primitives (by position) that go left. The last
 /// primitive always goes right, so each bipartition is tried once; ties go to the earliest in
 /// [`ORDER`]. `subsets` is scratch. `None` when no bipartition has a finite price.
+///
+/// Inlined into the builder: returned through memory, the cut (two boxes and four prices) was
+/// read back at once after the call, waiting on its own stores; inlined, the SAH build took 4%
+/// less time on the bunny and Crytek Sponza (thread CPU, three interleaved rounds).
+#[inline(always)]
 pub(crate) fn cheapest_bipartition<M: CostModel>(
     prims: &[PrimRef],
     subsets: &mut [Bin; SUBSETS],

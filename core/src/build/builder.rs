@@ -965,7 +965,7 @@ fn ceil_log2(n: u32) -> u32 {
 }
 
 /// Partitions the node's slots in place by the split's bin boundary. The child boxes come from
-/// the bins; the children's centroid bounds are gathered as each slot is classified.
+/// the bins; the children's centroid bounds from the slots each side ends up with.
 fn partition(arena: &mut BuildArena, task: &Task, split: &Split, map: &BinMap) -> (Child, Child) {
     // Finding the threshold costs a few dozen bin evaluations: small nodes classify by bin.
     let at = split.cut.at;

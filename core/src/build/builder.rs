@@ -4,6 +4,7 @@ use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRefs, Sweep, Task};
 use super::binning::{BinJob, NodeBinner, SerialBinner, BIN_BYTES};
 use super::config::{BinSpace, BuildConfig, CutEvaluation};
 use super::exhaustive::{cheapest_bipartition, partition_by_mask};
+use super::keys::cheapest_lane;
 use super::partition::{centroid_bounds, swap_misplaced};
 use super::profile::{Clock, NoClock, PhaseProfile};
 use crate::bvh::{Bvh, BvhNode, WideBvh};
@@ -881,19 +882,8 @@ fn sweep_any<M: CostModel>(bins: &[Bin], sweep: &mut Sweep, model: &M, hint: u32
         best_mr = better.select(mr, best_mr);
         index += f32x4::splat(4.0);
     }
-    let (w, i) = (best_w.to_array(), best_i.to_array());
-    // `<` against +inf also drops NaN and infinite prices. The boundary stays a float until the
-    // winner is known: a saturating float-to-integer conversion per lane costs more than the rest.
-    let (mut weighted, mut at, mut won) = (f32::INFINITY, f32::INFINITY, 0);
-    for lane in 0..4 {
-        if w[lane] < weighted || (w[lane] == weighted && i[lane] < at) {
-            (weighted, at, won) = (w[lane], i[lane], lane);
-        }
-    }
-    if !weighted.is_finite() {
-        return None;
-    }
-    let at = at as usize;
+    // The cheapest lane, ties to the lowest boundary; NaN and infinite prices never win.
+    let (weighted, at, won) = cheapest_lane(best_w, best_i)?;
     Some(Cut {
         at,
         left: sweep.left.bounds(at),

@@ -20,6 +20,7 @@
 use super::arena::{lanes_to_aabb, soa, Bin, PrimRef};
 use super::builder::Cut;
 use super::config::MAX_EXHAUSTIVE;
+use super::keys::cheapest_lane;
 use crate::heuristics::CostModel;
 use crate::simd::Aabb4;
 use wide::f32x4;
@@ -111,19 +112,9 @@ pub(crate) fn cheapest_bipartition<M: CostModel>(
         best_ml = better.select(ml, best_ml);
         best_mr = better.select(mr, best_mr);
     }
-    // Across lanes: the lowest price, ties to the earliest in `ORDER`. `<` against +inf also
-    // drops NaN.
-    let (w, at) = (best_w.to_array(), best_at.to_array());
-    let (mut weighted, mut won) = (f32::INFINITY, 0);
-    for lane in 0..4 {
-        if w[lane] < weighted || (w[lane] == weighted && at[lane] < at[won]) {
-            (weighted, won) = (w[lane], lane);
-        }
-    }
-    if !weighted.is_finite() {
-        return None;
-    }
-    let mask = order[at[won] as usize] as usize;
+    // Across lanes: the lowest price, ties to the earliest in `ORDER`; NaN never wins.
+    let (weighted, at, won) = cheapest_lane(best_w, best_at)?;
+    let mask = order[at] as usize;
     let (l, r) = (&subsets[mask], &subsets[all ^ mask]);
     let cut = Cut {
         at: mask,

@@ -11,6 +11,7 @@ mod builder;
 mod config;
 mod exhaustive;
 mod graft;
+mod keys;
 mod partition;
 mod preset;
 mod profile;

@@ -20,6 +20,7 @@ use alloc::vec::Vec;
 use bytemuck::Zeroable;
 use core::cmp::Reverse;
 
+use super::keys::{ordered, unordered};
 use crate::bvh::{Bvh, BvhNode, MAX_DEPTH};
 use crate::geometry::Aabb;
 use crate::heuristics::CostModel;
@@ -96,23 +97,6 @@ pub struct ReinsertStats {
     /// True when the settings were not [valid](ReinsertConfig::is_valid), so nothing ran and the
     /// tree is unchanged.
     pub invalid_config: bool,
-}
-
-/// A float's bits, mapped so that unsigned order is [`f32::total_cmp`]'s order.
-#[inline(always)]
-fn ordered(x: f32) -> u32 {
-    let b = x.to_bits();
-    if b >> 31 == 1 {
-        !b
-    } else {
-        b | 1 << 31
-    }
-}
-
-/// The inverse of [`ordered`].
-#[inline(always)]
-fn unordered(k: u32) -> f32 {
-    f32::from_bits(if k >> 31 == 1 { k & !(1 << 31) } else { !k })
 }
 
 /// Buckets of [`bucket`]: a positive finite float's exponent and its top three mantissa bits.
@@ -737,28 +721,6 @@ mod tests {
                     reference(&r.measure, r.root, fraction),
                     "{round} {fraction}"
                 );
-            }
-        }
-    }
-
-    #[test]
-    fn ordered_bits_sort_as_total_cmp() {
-        let xs = [
-            f32::NEG_INFINITY,
-            -3.5,
-            -f32::MIN_POSITIVE,
-            -0.0,
-            0.0,
-            1e-40,
-            f32::MIN_POSITIVE,
-            1.0,
-            2.5e30,
-            f32::INFINITY,
-        ];
-        for a in xs {
-            assert_eq!(unordered(ordered(a)).to_bits(), a.to_bits());
-            for b in xs {
-                assert_eq!(ordered(a).cmp(&ordered(b)), a.total_cmp(&b), "{a} {b}");
             }
         }
     }

@@ -117,20 +117,56 @@ pub fn build_preset(
     options: &PresetOptions,
     arena: &mut BuildArena,
 ) -> Result<Bvh, PresetError> {
-    /// Runs the preset's builder on every thread.
-    struct Threaded<'a>(&'a mut BuildArena);
-    impl PresetVisitor for Threaded<'_> {
-        type Output = Result<Bvh, BuildError>;
-        fn visit<A, C, T>(self, builder: Builder<A, C, T>) -> Self::Output
-        where
-            A: AxisChooser + Send + Sync,
-            C: CostModel + Send + Sync,
-            T: Termination + Send + Sync,
-        {
-            build_arena(&builder, self.0)
+    Ok(preset.with_builder(
+        area,
+        options,
+        Threaded {
+            arena,
+            for_wide: false,
+        },
+    )??)
+}
+
+/// [`build_preset`] for a tree that is only to be collapsed to 4-wide nodes: the preset's builder
+/// made [`Builder::for_wide`], so nodes of at most four triangles are not split (the collapse
+/// would make each one leaf block anyway). `WideBvh::from_binary` of the result has the nodes of
+/// the full tree's collapse; the build skips about a fifth of its work.
+pub fn build_preset_for_wide(
+    preset: Preset,
+    area: Option<&InfluenceArea>,
+    options: &PresetOptions,
+    arena: &mut BuildArena,
+) -> Result<Bvh, PresetError> {
+    Ok(preset.with_builder(
+        area,
+        options,
+        Threaded {
+            arena,
+            for_wide: true,
+        },
+    )??)
+}
+
+/// Runs a preset's builder (made [`Builder::for_wide`] when asked) on every thread.
+struct Threaded<'a> {
+    arena: &'a mut BuildArena,
+    for_wide: bool,
+}
+
+impl PresetVisitor for Threaded<'_> {
+    type Output = Result<Bvh, BuildError>;
+    fn visit<A, C, T>(self, builder: Builder<A, C, T>) -> Self::Output
+    where
+        A: AxisChooser + Send + Sync,
+        C: CostModel + Send + Sync,
+        T: Termination + Send + Sync,
+    {
+        if self.for_wide {
+            build_arena(&builder.for_wide(), self.arena)
+        } else {
+            build_arena(&builder, self.arena)
         }
     }
-    Ok(preset.with_builder(area, options, Threaded(arena))??)
 }
 
 /// Builds over the primitives loaded in `arena` with every rayon thread. Equal to

@@ -216,6 +216,14 @@ impl BuilderArgs {
         self.build_over(triangles, None, None)
     }
 
+    /// Builds a BVH over all `triangles` that is only to be traced through its 4-wide collapse
+    /// (`WideBvh::from_binary`). Without --reinsert the builder is made `for_wide`: the same wide
+    /// nodes, and nodes of at most four triangles left unsplit (about a fifth of the build's
+    /// work). With --reinsert the full tree is built, as reinsertion improves its collapse more.
+    pub fn build_for_wide(&self, triangles: &[Triangle]) -> Result<BuiltBvh, CliError> {
+        self.build_with(triangles, None, None, !self.reinsert)
+    }
+
     /// Builds a BVH over the triangles of `triangles` whose ids `subset` lists (all when
     /// `None`), for the influence area `area` when the preset needs one, on every thread of the
     /// current rayon pool ([`crate::parallel`]: the single-threaded build's tree, node for node).
@@ -224,6 +232,17 @@ impl BuilderArgs {
         triangles: &[Triangle],
         subset: Option<&[u32]>,
         area: Option<&InfluenceArea>,
+    ) -> Result<BuiltBvh, CliError> {
+        self.build_with(triangles, subset, area, false)
+    }
+
+    /// [`BuilderArgs::build_over`], with the builder made `for_wide` when `for_wide` is true.
+    fn build_with(
+        &self,
+        triangles: &[Triangle],
+        subset: Option<&[u32]>,
+        area: Option<&InfluenceArea>,
+        for_wide: bool,
     ) -> Result<BuiltBvh, CliError> {
         self.check_area(area.is_some())?;
         let n = subset.map_or(triangles.len(), <[u32]>::len);
@@ -234,17 +253,24 @@ impl BuilderArgs {
             Some(ids) => arena.load_triangle_subset(triangles, ids.iter().copied())?,
             None => parallel::load_triangles(&mut arena, triangles)?,
         }
-        let mut bvh = match self.preset() {
-            Some(p) => parallel::build_preset(p, area, &self.preset_options(), &mut arena)?,
+        let options = self.preset_options();
+        let mut bvh = match (self.preset(), for_wide) {
+            (Some(p), false) => parallel::build_preset(p, area, &options, &mut arena)?,
+            (Some(p), true) => parallel::build_preset_for_wide(p, area, &options, &mut arena)?,
             // Only the bins and the leaf size change: each builder keeps the rest of its own
             // configuration (LSPH evaluates its first axis only, which a default config would
             // undo).
-            None => match self.kind() {
-                BuilderKind::Sah => parallel::build_arena(&self.apply(Builder::sah()), &mut arena)?,
-                BuilderKind::Lsph => {
-                    parallel::build_arena(&self.apply(Builder::lsph()), &mut arena)?
+            (None, _) => {
+                let (sah, lsph) = (self.apply(Builder::sah()), self.apply(Builder::lsph()));
+                match (self.kind(), for_wide) {
+                    (BuilderKind::Sah, false) => parallel::build_arena(&sah, &mut arena)?,
+                    (BuilderKind::Sah, true) => parallel::build_arena(&sah.for_wide(), &mut arena)?,
+                    (BuilderKind::Lsph, false) => parallel::build_arena(&lsph, &mut arena)?,
+                    (BuilderKind::Lsph, true) => {
+                        parallel::build_arena(&lsph.for_wide(), &mut arena)?
+                    }
                 }
-            },
+            }
         };
         let seconds = start.elapsed().as_secs_f64();
         let reinsert = self.reinsert.then(|| {
@@ -276,6 +302,7 @@ impl BuilderArgs {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rdbvh_core::bvh::WideBvh;
     use rdbvh_core::influence::PlaneArea;
     use rdbvh_core::Vec3;
 
@@ -286,6 +313,45 @@ mod tests {
                 Triangle::new(o, o + Vec3::X, o + Vec3::Y)
             })
             .collect()
+    }
+
+    /// `trace`'s build collapses to the wide tree of the full build: a `for_wide` build without
+    /// --reinsert (the same wide nodes, fewer binary ones), the full build with it.
+    #[test]
+    fn the_build_for_wide_collapses_as_the_full_build() {
+        let mut tris = row(300);
+        tris.extend(
+            row(40)
+                .iter()
+                .map(|t| Triangle::new(t.v0, t.v1 * 3.0, t.v2 + Vec3::Z)),
+        );
+        let cases = [
+            BuilderArgs::default(),
+            BuilderArgs {
+                builder: Some(BuilderKind::Lsph),
+                max_leaf: Some(2),
+                ..BuilderArgs::default()
+            },
+            BuilderArgs {
+                preset: Some(PresetArg(Preset::Standard)),
+                thesis_mode: true,
+                ..BuilderArgs::default()
+            },
+            BuilderArgs {
+                reinsert: true,
+                ..BuilderArgs::default()
+            },
+        ];
+        for args in cases {
+            let (full, for_wide) = (
+                args.build(&tris).unwrap(),
+                args.build_for_wide(&tris).unwrap(),
+            );
+            let wide = |b: &BuiltBvh| WideBvh::from_binary(&b.bvh, &tris);
+            assert_eq!(wide(&full).nodes(), wide(&for_wide).nodes(), "{args:?}");
+            let smaller = for_wide.bvh.nodes().len() < full.bvh.nodes().len();
+            assert_eq!(smaller, !args.reinsert, "{args:?}");
+        }
     }
 
     #[test]

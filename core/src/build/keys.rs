@@ -2,7 +2,7 @@
 //! is one integer minimum: no branch on which price is lower, which the branch predictor cannot
 //! guess (the build compares such prices at every node).
 
-use wide::f32x4;
+use wide::{f32x4, i32x4};
 
 /// A float's bits, mapped so that unsigned order is [`f32::total_cmp`]'s order.
 #[inline(always)]
@@ -29,14 +29,18 @@ pub(crate) fn cheapest_lane(price: f32x4, rank: f32x4) -> Option<(f32, usize, us
     // NaN as +inf, -0 as +0 (x + 0 is x for every other x).
     let price = price
         .simd_eq(price)
-        .select(price + f32x4::ZERO, f32x4::splat(f32::INFINITY))
-        .to_array();
+        .select(price + f32x4::ZERO, f32x4::splat(f32::INFINITY));
+    // Total order as signed integers, four lanes at once: a negative float's magnitude bits
+    // flipped, so that more negative sorts lower.
+    let bits: i32x4 = bytemuck::cast(price);
+    let sign: i32x4 = bits >> 31_i32;
+    let ordered = (bits ^ (sign & i32x4::splat(i32::MAX))).to_array();
     let rank = rank.fast_trunc_int().to_array();
     let key = |l: usize| {
-        u64::from(ordered(price[l])) << 32 | u64::from(rank[l] as u32 & 0x1fff_ffff) << 2 | l as u64
+        i64::from(ordered[l]) << 32 | i64::from(rank[l] as u32 & 0x1fff_ffff) << 2 | l as i64
     };
     let lane = (key(0).min(key(1)).min(key(2).min(key(3))) & 3) as usize;
-    let p = price[lane];
+    let p = price.to_array()[lane];
     p.is_finite().then_some((p, rank[lane] as usize, lane))
 }
 
@@ -83,6 +87,9 @@ mod tests {
             -0.0,
             1.0,
             2.5,
+            -1.0,
+            -3.0,
+            f32::NEG_INFINITY,
             f32::INFINITY,
             f32::NAN,
             -f32::NAN,

@@ -3,9 +3,9 @@
 //! A binary build is split where subtrees get small: the core builds the top of the tree on one
 //! thread and hands over each node of at most `cutoff` primitives as a job the moment it reaches
 //! it ([`Builder::build_top_into`]); rayon builds the jobs on all threads while the top goes on,
-//! each over its own arena at its own depth and with its root's measure as the top priced it
-//! ([`Builder::build_subtree_into`]); [`Bvh::graft`] splices them in and re-lays the nodes out in
-//! the single-threaded order. The result is the single-threaded tree node for node, which the
+//! the largest waiting first, each over its own arena at its own depth and with its root's
+//! measure as the top priced it ([`Builder::build_subtree_into`]); [`Bvh::graft_with`] splices
+//! them in and re-lays the nodes out in the single-threaded order, copying on all threads. The result is the single-threaded tree node for node, which the
 //! tests check. Scenes build their local BVHs and the fallback BVH concurrently.
 //!
 //! The serial part is kept small: the triangle bounds are loaded in parallel parts
@@ -117,14 +117,11 @@ pub fn build_preset(
     options: &PresetOptions,
     arena: &mut BuildArena,
 ) -> Result<Bvh, PresetError> {
-    Ok(preset.with_builder(
-        area,
-        options,
-        Threaded {
-            arena,
-            for_wide: false,
-        },
-    )??)
+    let threaded = Threaded {
+        arena,
+        for_wide: false,
+    };
+    Ok(preset.with_builder(area, options, threaded)??)
 }
 
 /// [`build_preset`] for a tree that is only to be collapsed to 4-wide nodes: the preset's builder
@@ -137,14 +134,11 @@ pub fn build_preset_for_wide(
     options: &PresetOptions,
     arena: &mut BuildArena,
 ) -> Result<Bvh, PresetError> {
-    Ok(preset.with_builder(
-        area,
-        options,
-        Threaded {
-            arena,
-            for_wide: true,
-        },
-    )??)
+    let threaded = Threaded {
+        arena,
+        for_wide: true,
+    };
+    Ok(preset.with_builder(area, options, threaded)??)
 }
 
 /// Runs a preset's builder (made [`Builder::for_wide`] when asked) on every thread.

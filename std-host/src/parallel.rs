@@ -117,11 +117,7 @@ pub fn build_preset(
     options: &PresetOptions,
     arena: &mut BuildArena,
 ) -> Result<Bvh, PresetError> {
-    let threaded = Threaded {
-        arena,
-        for_wide: false,
-    };
-    Ok(preset.with_builder(area, options, threaded)??)
+    build_preset_as(preset, area, options, arena, false)
 }
 
 /// [`build_preset`] for a tree that is only to be collapsed to 4-wide nodes: the preset's builder
@@ -134,11 +130,18 @@ pub fn build_preset_for_wide(
     options: &PresetOptions,
     arena: &mut BuildArena,
 ) -> Result<Bvh, PresetError> {
-    let threaded = Threaded {
-        arena,
-        for_wide: true,
-    };
-    Ok(preset.with_builder(area, options, threaded)??)
+    build_preset_as(preset, area, options, arena, true)
+}
+
+/// [`build_preset`], its builder made [`Builder::for_wide`] when `for_wide` is true.
+fn build_preset_as(
+    preset: Preset,
+    area: Option<&InfluenceArea>,
+    options: &PresetOptions,
+    arena: &mut BuildArena,
+    for_wide: bool,
+) -> Result<Bvh, PresetError> {
+    Ok(preset.with_builder(area, options, Threaded { arena, for_wide })??)
 }
 
 /// Runs a preset's builder (made [`Builder::for_wide`] when asked) on every thread.
@@ -155,11 +158,26 @@ impl PresetVisitor for Threaded<'_> {
         C: CostModel + Send + Sync,
         T: Termination + Send + Sync,
     {
-        if self.for_wide {
-            build_arena(&builder.for_wide(), self.arena)
-        } else {
-            build_arena(&builder, self.arena)
-        }
+        build_arena_as(builder, self.arena, self.for_wide)
+    }
+}
+
+/// [`build_arena`] with `builder`, made [`Builder::for_wide`] when `for_wide` is true (a tree only
+/// to be collapsed to 4-wide nodes).
+pub(crate) fn build_arena_as<A, C, T>(
+    builder: Builder<A, C, T>,
+    arena: &mut BuildArena,
+    for_wide: bool,
+) -> Result<Bvh, BuildError>
+where
+    A: AxisChooser + Sync,
+    C: CostModel + Sync,
+    T: Termination + Sync,
+{
+    if for_wide {
+        build_arena(&builder.for_wide(), arena)
+    } else {
+        build_arena(&builder, arena)
     }
 }
 

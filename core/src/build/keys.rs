@@ -21,9 +21,10 @@ pub(crate) fn unordered(k: u32) -> f32 {
     f32::from_bits(if k >> 31 == 1 { k & !(1 << 31) } else { !k })
 }
 
-/// The lane of the lowest finite price in `price`, ties to the lowest `rank` (small non-negative
-/// whole numbers, below 2^29), as `(price, rank, lane)`; `None` when no price is finite. A NaN
-/// price never wins, and `-0` ties with `0`, as comparing with `<` has it.
+/// The lane of the lowest finite price in `price`, ties to the lowest `rank` then the first lane,
+/// as `(price, rank, lane)`; `None` when no price is finite. Ranks are whole numbers below 2^29
+/// (a lane priced infinite or NaN may carry any rank: it never wins). A NaN price never wins, and
+/// `-0` ties with `0`, as comparing with `<` has it.
 #[inline(always)]
 pub(crate) fn cheapest_lane(price: f32x4, rank: f32x4) -> Option<(f32, usize, usize)> {
     // NaN as +inf, -0 as +0 (x + 0 is x for every other x).

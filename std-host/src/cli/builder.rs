@@ -260,17 +260,14 @@ impl BuilderArgs {
             // Only the bins and the leaf size change: each builder keeps the rest of its own
             // configuration (LSPH evaluates its first axis only, which a default config would
             // undo).
-            (None, _) => {
-                let (sah, lsph) = (self.apply(Builder::sah()), self.apply(Builder::lsph()));
-                match (self.kind(), for_wide) {
-                    (BuilderKind::Sah, false) => parallel::build_arena(&sah, &mut arena)?,
-                    (BuilderKind::Sah, true) => parallel::build_arena(&sah.for_wide(), &mut arena)?,
-                    (BuilderKind::Lsph, false) => parallel::build_arena(&lsph, &mut arena)?,
-                    (BuilderKind::Lsph, true) => {
-                        parallel::build_arena(&lsph.for_wide(), &mut arena)?
-                    }
+            (None, _) => match self.kind() {
+                BuilderKind::Sah => {
+                    parallel::build_arena_as(self.apply(Builder::sah()), &mut arena, for_wide)?
                 }
-            }
+                BuilderKind::Lsph => {
+                    parallel::build_arena_as(self.apply(Builder::lsph()), &mut arena, for_wide)?
+                }
+            },
         };
         let seconds = start.elapsed().as_secs_f64();
         let reinsert = self.reinsert.then(|| {

@@ -26,6 +26,8 @@ pub use projection::{
     windowed_silhouette, MIN_RELATIVE_DEPTH, PRECISE_SPAN,
 };
 pub use ray::{Ray, RayError};
-pub use solid_angle::{box_solid_angle4, box_solid_angle_far4, far_field4, FAR_FIELD};
+#[cfg(test)]
+pub(crate) use solid_angle::tests::reference as box_solid_angle_f64;
+pub use solid_angle::{box_solid_angle4, box_solid_angle_far4, far_field4, FarFace, FAR_FIELD};
 pub use triangle::{Triangle, TriangleHit};
 pub use triangle4::{Hits4, RayTri4, Triangle4};

@@ -141,11 +141,13 @@ pub(crate) struct Cut {
 
 impl Cut {
     /// The same cut priced under `model` instead of the model that found it: both sides in
-    /// one 4-wide evaluation.
+    /// one 4-wide evaluation, with what `model` settled for the node (`hint`, 0 for nothing).
     #[inline]
-    pub(crate) fn priced_under(self, model: &impl CostModel) -> Cut {
+    pub(crate) fn priced_under(self, model: &impl CostModel, hint: u32) -> Cut {
         let (l, r) = (self.left, self.right);
-        let m = model.measure4(&Aabb4::from_boxes([l, r, l, r])).to_array();
+        let m = model
+            .measure4_hinted(&Aabb4::from_boxes([l, r, l, r]), hint)
+            .to_array();
         let (ml, mr) = (m[0], m[1]);
         Cut {
             measure_left: ml,
@@ -640,7 +642,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             let mut found = None;
             let split = walk(cut, &order, parent, largest, |axis, sah| {
                 if sah {
-                    return split_pair(&Sah, arena, task, axis, nb).map(|c| c.priced_under(model));
+                    return split_pair(&Sah, arena, task, axis, nb).map(|c| c.priced_under(model, 0));
                 }
                 found = found.or_else(|| split_pair(model, arena, task, axis, nb));
                 found
@@ -661,7 +663,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             let t0 = clock.now_ns();
             let bins = &bins[axis][..nb];
             let cut = if sah {
-                sweep_axis(bins, sweep, &Sah, 0).map(|c| c.priced_under(model))
+                sweep_axis(bins, sweep, &Sah, 0).map(|c| c.priced_under(model, hint))
             } else {
                 sweep_axis(bins, sweep, model, hint)
             };

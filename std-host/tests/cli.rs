@@ -952,6 +952,22 @@ fn trace_through_the_structure_agrees_with_brute_force() {
     let random = random_rays(&scene, 500, 9);
     let rate = check_structure_trace("builtin:room", &areas_file, &random, &[], &dir);
     assert!(rate < 1.0, "random rays: local hit rate {rate}%");
+    // Without --preset the local BVHs are `pah`'s (`DEFAULT_LOCAL_PRESET`), and the summary
+    // names it.
+    let (rays_csv, hits_csv) = (dir.join("rays.csv"), dir.join("hits.csv"));
+    let out = rdbvh(&[
+        "trace",
+        "builtin:room",
+        "--areas",
+        areas_file.to_str().unwrap(),
+        "--rays",
+        rays_csv.to_str().unwrap(),
+        "--out",
+        hits_csv.to_str().unwrap(),
+    ]);
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("structure: `pah`"), "{stderr}");
     std::fs::remove_dir_all(&dir).ok();
 }
 

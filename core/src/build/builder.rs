@@ -642,7 +642,8 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
             let mut found = None;
             let split = walk(cut, &order, parent, largest, |axis, sah| {
                 if sah {
-                    return split_pair(&Sah, arena, task, axis, nb).map(|c| c.priced_under(model, 0));
+                    return split_pair(&Sah, arena, task, axis, nb)
+                        .map(|c| c.priced_under(model, 0));
                 }
                 found = found.or_else(|| split_pair(model, arena, task, axis, nb));
                 found

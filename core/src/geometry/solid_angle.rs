@@ -101,11 +101,7 @@ pub struct FarFace {
 /// division per face), and it lets boxes 8 times the size the plain midpoint rule allowed (at
 /// 1% of the distance, for the same error) take this path.
 #[inline(always)]
-pub fn far_field4(
-    lo: &[f32x4; 3],
-    hi: &[f32x4; 3],
-    weight: impl Fn(&FarFace) -> f32x4,
-) -> f32x4 {
+pub fn far_field4(lo: &[f32x4; 3], hi: &[f32x4; 3], weight: impl Fn(&FarFace) -> f32x4) -> f32x4 {
     let zero = f32x4::ZERO;
     let half = f32x4::splat(0.5);
     let c = scaled(lo, hi);

@@ -84,7 +84,7 @@ pub fn trace() -> String {
          standard), traversed as its 4-wide collapse (same answers, faster). With --areas, rays are\n\
          answered through the scene structure: an octree (or a list) finds the areas that may\n\
          contain a ray's origin; a ray affine to one (origin inside, direction within 1 degree of\n\
-         the area's) searches that area's local BVH (built with --preset, default full) up to where\n\
+         the area's) searches that area's local BVH (built with --preset, default pah) up to where\n\
          it leaves the area, and otherwise the fallback BVH (binned SAH over the whole scene,\n\
          default settings) answers. The answers equal brute force either way. Standard error then\n\
          gets the local hit rate, the mean cost per ray (C_trav = C_isect = 1) with the structure\n\

@@ -22,8 +22,12 @@ use super::trace::{write_answers, Answers, LookupKind, TraceArgs};
 use super::{load_scene, CliError};
 use crate::parallel::build_scene;
 
-/// The preset of the local BVHs when `--preset` is not given: the thesis's full method.
-pub const DEFAULT_LOCAL_PRESET: Preset = Preset::Full;
+/// The preset of the local BVHs when `--preset` is not given: `pah`, the binned SAH builder
+/// pricing its cuts with the area's PAH ([`SceneOptions`]'s default too). Over the thesis's 48
+/// configurations with published scenes (20,000 rays each), its local trees cost 0.98x the `sah`
+/// trees per ray (geometric mean; 0.69x to 1.32x), the thesis's `full` 1.07x (0.69x to 1.69x);
+/// `benches/RESULTS.md`, twelfth session.
+pub const DEFAULT_LOCAL_PRESET: Preset = Preset::Pah;
 
 /// What tracing a batch through the structure did, with the fallback BVH alone as the baseline.
 #[derive(Clone, Debug, PartialEq)]
@@ -154,7 +158,7 @@ fn fallback_alone(
         .sum()
 }
 
-/// The scene-structure options of a command line: the local preset (`full` unless --preset says
+/// The scene-structure options of a command line: the local preset (`pah` unless --preset says
 /// otherwise) with --thesis-mode/--bins/--max-leaf, the fallback with the defaults, and with
 /// --reinsert every tree reinserted with the default settings.
 pub fn structure_options(args: &TraceArgs) -> SceneOptions {

@@ -280,16 +280,20 @@ fn ray_of(record: &csv::StringRecord, columns: &Columns) -> Result<Ray, String> 
         if text.is_empty() {
             return Ok(None);
         }
-        // Echoed escaped and cut short: a quoted cell may hold newlines or a whole file.
-        let cut: String = text.chars().take(40).collect();
-        let more = if text.chars().count() > 40 { "..." } else { "" };
-        let shown = format!("{}{more}", cut.escape_debug());
+        // Echoed escaped and cut short: a quoted cell may hold newlines or a whole file. Only
+        // made for an error: building it for every cell took a quarter of a million-ray trace.
+        let shown = || {
+            let cut: String = text.chars().take(40).collect();
+            let more = if text.chars().count() > 40 { "..." } else { "" };
+            format!("{}{more}", cut.escape_debug())
+        };
         let value = text
             .parse::<f32>()
-            .map_err(|_| format!("column '{name}': cannot parse '{shown}' as a number"))?;
+            .map_err(|_| format!("column '{name}': cannot parse '{}' as a number", shown()))?;
         if finite && value.is_infinite() && !text.to_ascii_lowercase().contains("inf") {
             return Err(format!(
-                "column '{name}': {shown} is beyond single precision's range (about 3.4e38)"
+                "column '{name}': {} is beyond single precision's range (about 3.4e38)",
+                shown()
             ));
         }
         Ok(Some(value))

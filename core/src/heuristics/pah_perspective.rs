@@ -604,31 +604,15 @@ mod tests {
         let axis = |v: Vec3| [v.x, v.y, v.z].map(f64::from);
         let (r, u, f) = (axis(frame.right), axis(frame.up), axis(frame.forward));
         let dot = |p: [f64; 3], q: [f64; 3]| p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
-        let mut total = 0.0;
-        for k in 0..3 {
-            let side = if lo[k] > 0.0 {
-                lo[k]
-            } else if hi[k] < 0.0 {
-                hi[k]
-            } else {
-                continue;
-            };
-            let (a1, a2) = ((k + 1) % 3, (k + 2) % 3);
-            let corners = [(lo, lo), (hi, lo), (hi, hi), (lo, hi)].map(|(p, q)| {
-                let mut c = [0.0; 3];
-                (c[k], c[a1], c[a2]) = (side, p[a1], q[a2]);
-                let z = dot(c, f);
-                (dot(c, r) / z, dot(c, u) / z)
-            });
-            let twice: f64 = (0..4)
-                .map(|i| {
-                    let (p, q) = (corners[i], corners[(i + 1) % 4]);
-                    p.0 * q.1 - p.1 * q.0
-                })
-                .sum();
-            total += 0.5 * twice.abs();
-        }
-        total
+        crate::geometry::front_faces_f64(lo, hi)
+            .map(|face| {
+                let p = face.map(|c| (dot(c, r) / dot(c, f), dot(c, u) / dot(c, f)));
+                let twice: f64 = (0..4)
+                    .map(|i| p[i].0 * p[(i + 1) % 4].1 - p[i].1 * p[(i + 1) % 4].0)
+                    .sum();
+                0.5 * twice.abs()
+            })
+            .sum()
     }
 
     #[test]

@@ -28,8 +28,9 @@ const DET_EPSILON_SQ: f64 = (8.0 * f32::EPSILON as f64) * (8.0 * f32::EPSILON as
 /// determinant is at least `2^-149 * 8 / 2^-23 = 2^-123` times `max(1, |d|, |d| / |e|)`.
 const PRECISION_FLOOR_SQ: f64 = 1.0 / (1u128 << 123) as f64 / (1u128 << 123) as f64;
 
-/// True when Moller-Trumbore's f32 determinant `det` (for direction `dir` and edges `e1`, `e2`)
-/// cannot be trusted, so its `u`, `v` and `t` are meaningless:
+/// True when Moller-Trumbore's f32 determinant `det` (for a direction `d` of squared length
+/// `dir_len_sq`, [`Ray::dir_len_sq`], and edges `e1`, `e2`) cannot be trusted, so its `u`, `v`
+/// and `t` are meaningless:
 /// - within the rounding error of zero, `|det| <= 8 eps |d| |e1| |e2|` (a degenerate triangle,
 ///   or a ray in its plane);
 /// - infinite (the products overflowed);
@@ -44,7 +45,7 @@ const PRECISION_FLOOR_SQ: f64 = 1.0 / (1u128 << 123) as f64 / (1u128 << 123) as 
 /// under about 1e-9 units. Shared by the scalar and the 4-wide test, so both decide alike. Runs
 /// only for a hit that passed every other test.
 #[inline]
-pub(crate) fn determinant_is_noise(det: f32, dir: Vec3, e1: Vec3, e2: Vec3) -> bool {
+pub(crate) fn determinant_is_noise(det: f32, dir_len_sq: f64, e1: Vec3, e2: Vec3) -> bool {
     let len_sq = |v: Vec3| {
         let (x, y, z) = (f64::from(v.x), f64::from(v.y), f64::from(v.z));
         x * x + y * y + z * z
@@ -53,7 +54,7 @@ pub(crate) fn determinant_is_noise(det: f32, dir: Vec3, e1: Vec3, e2: Vec3) -> b
         return true;
     }
     let det_sq = f64::from(det) * f64::from(det);
-    let (d, a, b) = (len_sq(dir), len_sq(e1), len_sq(e2));
+    let (d, a, b) = (dir_len_sq, len_sq(e1), len_sq(e2));
     let floor = PRECISION_FLOOR_SQ * 1f64.max(d).max(d / a.max(b));
     det_sq <= DET_EPSILON_SQ * (d * a * b) || det_sq < floor || d * b < PRECISION_FLOOR_SQ
 }
@@ -160,7 +161,7 @@ impl Triangle {
         // "hit" can lie anywhere, far from the triangle. |det| <= |d| |e1| |e2| always, and its
         // rounding error is a few ulps of that bound, so such hits are rejected. Checked only
         // after everything else passed: hits are rare, misses pay nothing.
-        if determinant_is_noise(det, ray.dir, e1, e2) {
+        if determinant_is_noise(det, ray.dir_len_sq, e1, e2) {
             return None;
         }
         Some(TriangleHit { t, u, v })

@@ -42,7 +42,7 @@ pub struct Hits4 {
     pub v: [f32; 4],
 }
 
-/// A ray's origin, anchor and direction splatted over four lanes, and the direction itself for the
+/// A ray's origin, anchor and direction splatted over four lanes, and its squared length for the
 /// determinant check, prepared once per ray.
 #[derive(Clone, Copy, Debug)]
 pub struct RayTri4 {
@@ -52,7 +52,7 @@ pub struct RayTri4 {
     anchor_t: f32x4,
     anchor_split: f32x4,
     dir: [f32x4; 3],
-    dir3: Vec3,
+    dir_len_sq: f64,
     t_min: f32x4,
 }
 
@@ -67,7 +67,7 @@ impl RayTri4 {
             anchor_t: s(ray.anchor_t),
             anchor_split: s(ray.anchor_split),
             dir: [s(ray.dir.x), s(ray.dir.y), s(ray.dir.z)],
-            dir3: ray.dir,
+            dir_len_sq: ray.dir_len_sq,
             t_min: s(ray.t_min),
         }
     }
@@ -158,7 +158,12 @@ impl Triangle4 {
             let edge = |e: &[[f32; 4]; 3], j: usize| Vec3::new(e[0][j], e[1][j], e[2][j]);
             for (j, &det) in det.to_array().iter().enumerate() {
                 if mask & (1 << j) != 0
-                    && determinant_is_noise(det, ray.dir3, edge(&self.e1, j), edge(&self.e2, j))
+                    && determinant_is_noise(
+                        det,
+                        ray.dir_len_sq,
+                        edge(&self.e1, j),
+                        edge(&self.e2, j),
+                    )
                 {
                     mask &= !(1 << j);
                 }

@@ -4,6 +4,7 @@ use alloc::vec::Vec;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
+use wide::f32x4;
 
 use super::collapse::{CollapsePlan, LEAF_BLOCK};
 use super::{Bvh, BvhNode, MAX_DEPTH};
@@ -75,6 +76,11 @@ pub struct WideBvh {
     pub(crate) tris: Vec<Triangle4>,
     pub(crate) max_depth: u32,
     bounds: Aabb,
+    /// The union of the root's children's boxes as `(x, y, z, _)` lanes, lane 3 spanning
+    /// `-inf..inf` (empty for an empty tree): the traversals' first, set-up-free test
+    /// ([`WideBvh::misses_root`](crate::bvh::WideBvh)).
+    pub(crate) root_min: f32x4,
+    pub(crate) root_max: f32x4,
 }
 
 impl WideBvh {
@@ -92,11 +98,25 @@ impl WideBvh {
     /// that costs less than opening it, and a larger binary leaf a leaf of consecutive blocks.
     /// Depth never grows. Ids missing from `tris` are dropped, as the binary traversal skips them.
     pub fn from_binary(bvh: &Bvh, tris: &[Triangle]) -> Self {
+        let mut out = Self::collapse(bvh, tris);
+        let root = out.nodes.first().map_or(Aabb::EMPTY, |root| {
+            (0..4).fold(Aabb::EMPTY, |b, i| b.union(root.child_bounds(i)))
+        });
+        let (lo, hi) = (root.min, root.max);
+        out.root_min = f32x4::from([lo.x, lo.y, lo.z, f32::NEG_INFINITY]);
+        out.root_max = f32x4::from([hi.x, hi.y, hi.z, f32::INFINITY]);
+        out
+    }
+
+    /// [`WideBvh::from_binary`] but for the root's box.
+    fn collapse(bvh: &Bvh, tris: &[Triangle]) -> Self {
         let mut out = WideBvh {
             nodes: Vec::with_capacity(bvh.nodes.len() / 4 + 1),
             tris: Vec::with_capacity(bvh.prim_indices.len() / 2 + 1),
             max_depth: 0,
             bounds: bvh.bounds(),
+            root_min: f32x4::ZERO,
+            root_max: f32x4::ZERO,
         };
         if bvh.nodes.is_empty() {
             return out;

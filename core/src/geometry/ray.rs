@@ -64,9 +64,8 @@ pub struct Ray {
     pub(crate) anchor_split: f32,
     /// `|dir|^2` in f64, where no finite f32 direction's square overflows or underflows: the
     /// triangle tests' determinant check (`determinant_is_noise`) needs it for every hit. Kept
-    /// here because, left to each test, it was hoisted into the 4-wide traversal's set-up and
-    /// computed for every ray, hit or not (12 instructions of a ray that misses the root's
-    /// children, about 160 in all).
+    /// here (the anchor computes it anyway) because, left to each test, LLVM hoisted it into the
+    /// 4-wide traversal's set-up, where every ray computed it, hit or not.
     pub(crate) dir_len_sq: f64,
 }
 

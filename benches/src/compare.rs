@@ -246,6 +246,11 @@ pub struct PahBuilds {
     pub full_plane: Timing,
     /// `Preset::Full` with a point area over the scene (radial rays, perspective PAH).
     pub full_point: Timing,
+    /// `Preset::Pah` (SAH's builder pricing its cuts with the area's PAH; the default of the
+    /// scene structure's local BVHs) with the plane area.
+    pub pah_plane: Timing,
+    /// `Preset::Pah` with the point area.
+    pub pah_point: Timing,
 }
 
 /// Everything one run measured.
@@ -425,7 +430,8 @@ pub fn point_area_over(b: &Aabb) -> Result<PointArea, String> {
         .map_err(|e| format!("point area over the scene: {e}"))
 }
 
-/// rdbvh's `sah` build and the `full` preset over a plane and a point area, in that order.
+/// rdbvh's `sah` build, then the `full` and the `pah` presets over a plane and a point area, in
+/// that order.
 struct PahReps<'a> {
     tris: &'a [Triangle],
     areas: [InfluenceArea; 2],
@@ -444,16 +450,20 @@ impl<'a> PahReps<'a> {
             bvh: Bvh::with_capacity(tris.len()),
         };
         // Once untimed, so a failing build is an error here, not a skipped timing.
-        for k in 0..3 {
+        for k in 0..Self::BUILDS {
             reps.build(k)?;
         }
         Ok(reps)
     }
 
+    /// `sah`, then `full` and `pah` over the plane and the point area.
+    const BUILDS: usize = 5;
+
     fn build(&mut self, k: usize) -> Result<(), String> {
         let (preset, area) = match k {
             0 => (Preset::Sah, None),
-            _ => (Preset::Full, Some(&self.areas[k - 1])),
+            1 | 2 => (Preset::Full, Some(&self.areas[k - 1])),
+            _ => (Preset::Pah, Some(&self.areas[k - 3])),
         };
         self.arena
             .load_triangles(self.tris)
@@ -475,7 +485,7 @@ impl<'a> PahReps<'a> {
 
 impl Reps for PahReps<'_> {
     fn count(&self) -> usize {
-        3
+        Self::BUILDS
     }
 
     fn rep(
@@ -551,6 +561,8 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         sah: p[0],
         full_plane: p[1],
         full_point: p[2],
+        pah_plane: p[3],
+        pah_point: p[4],
     });
     let n = tris.len();
     let rows = fold_rows(&runs, n, sets[0].1.len(), sets[1].1.len(), opts.clock);
@@ -833,16 +845,26 @@ impl Report {
         }
         if let Some(p) = &self.pah {
             let m = |t: &Timing| rate(self.triangles, t, Measure::Build1t, self.clock);
-            let (sah, plane, point) = (m(&p.sah), m(&p.full_plane), m(&p.full_point));
+            let sah = m(&p.sah);
             let _ = writeln!(w);
-            let _ = writeln!(
+            let _ = write!(
                 w,
-                "PAH vs SAH, rdbvh presets, 1 thread: sah {sah:.2} Mtris/s; full (PAH+SPFH) plane \
-                 area {plane:.2} Mtris/s ({:.2}x the SAH time); full point area {point:.2} \
-                 Mtris/s ({:.2}x the SAH time)",
-                sah / plane.max(1e-12),
-                sah / point.max(1e-12)
+                "PAH vs SAH, rdbvh presets, 1 thread: sah {sah:.2} Mtris/s"
             );
+            for (name, plane, point) in [
+                ("full (PAH+SPFH)", &p.full_plane, &p.full_point),
+                ("pah (PAH, all axes)", &p.pah_plane, &p.pah_point),
+            ] {
+                let (plane, point) = (m(plane), m(point));
+                let _ = write!(
+                    w,
+                    "; {name} plane area {plane:.2} Mtris/s ({:.2}x the SAH time), point area \
+                     {point:.2} Mtris/s ({:.2}x)",
+                    sah / plane.max(1e-12),
+                    sah / point.max(1e-12)
+                );
+            }
+            let _ = writeln!(w);
         }
         s
     }

@@ -79,6 +79,7 @@ fn every_library_agrees_with_rdbvh_on_both_trees() {
     let text = report.text();
     assert!(text.contains("parry3d: no threaded build"), "{text}");
     assert!(text.contains("PAH vs SAH"), "{text}");
+    assert!(text.contains("pah (PAH, all axes) plane area"), "{text}");
 }
 
 #[test]

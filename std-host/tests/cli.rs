@@ -877,18 +877,18 @@ fn local_hit_rate(stderr: &str) -> f64 {
 }
 
 /// Runs `trace --areas AREAS` on `scene_arg` with `extra` options, closest and any hit, and checks
-/// every answer against brute force; returns the closest-hit local hit rate.
+/// every answer against brute force; returns the closest-hit local hit rate and summary.
 fn check_structure_trace(
     scene_arg: &str,
     areas_file: &Path,
     rays: &[[f32; 8]],
     extra: &[&str],
     dir: &Path,
-) -> f64 {
+) -> (f64, String) {
     let scene = Scene::open(scene_arg).unwrap();
     let rays_csv = dir.join("rays.csv");
     let rays = write_rays(&rays_csv, rays);
-    let mut rate = 0.0;
+    let (mut rate, mut summary) = (0.0, String::new());
     for any_hit in [false, true] {
         let hits_csv = dir.join("hits.csv");
         let mut args = vec![
@@ -910,13 +910,13 @@ fn check_structure_trace(
         assert!(out.status.success(), "{args:?}: {stderr}");
         let r = local_hit_rate(&stderr);
         if !any_hit {
-            rate = r;
+            (rate, summary) = (r, stderr.clone());
         }
         let label = format!("{scene_arg} {extra:?}");
         let hits = assert_answers(&hits_csv, &rays, &scene, any_hit, &label);
         assert!(hits > 0, "{label}: no hits");
     }
-    rate
+    (rate, summary)
 }
 
 #[test]
@@ -944,30 +944,20 @@ fn trace_through_the_structure_agrees_with_brute_force() {
         &["--reinsert"],
         &["--preset", "standard", "--reinsert", "--lookup", "list"],
     ] {
-        let rate = check_structure_trace("builtin:room", &areas_file, &rays, extra, &dir);
+        let (rate, summary) =
+            check_structure_trace("builtin:room", &areas_file, &rays, extra, &dir);
         // Most of the sampled rays are affine and hit inside their area.
         assert!(rate > 25.0, "{extra:?}: local hit rate {rate}%");
+        // Without --preset the local BVHs are `pah`'s (`DEFAULT_LOCAL_PRESET`), and the summary
+        // names it.
+        if extra.is_empty() {
+            assert!(summary.contains("structure: `pah`"), "{summary}");
+        }
     }
     // Unrelated rays only: nothing is answered locally, and the answers are still exact.
     let random = random_rays(&scene, 500, 9);
-    let rate = check_structure_trace("builtin:room", &areas_file, &random, &[], &dir);
+    let (rate, _) = check_structure_trace("builtin:room", &areas_file, &random, &[], &dir);
     assert!(rate < 1.0, "random rays: local hit rate {rate}%");
-    // Without --preset the local BVHs are `pah`'s (`DEFAULT_LOCAL_PRESET`), and the summary
-    // names it.
-    let (rays_csv, hits_csv) = (dir.join("rays.csv"), dir.join("hits.csv"));
-    let out = rdbvh(&[
-        "trace",
-        "builtin:room",
-        "--areas",
-        areas_file.to_str().unwrap(),
-        "--rays",
-        rays_csv.to_str().unwrap(),
-        "--out",
-        hits_csv.to_str().unwrap(),
-    ]);
-    let stderr = text(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
-    assert!(stderr.contains("structure: `pah`"), "{stderr}");
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -1006,7 +996,7 @@ fn trace_through_the_structure_on_thesis_scenes() {
         } else {
             &[]
         };
-        local += check_structure_trace(path.to_str().unwrap(), &experiments, &rays, extra, &dir);
+        local += check_structure_trace(path.to_str().unwrap(), &experiments, &rays, extra, &dir).0;
     }
     assert!(
         local > 0.0,

@@ -5,8 +5,9 @@
 //! it ([`Builder::build_top_into`]); rayon builds the jobs on all threads while the top goes on,
 //! the largest waiting first, each over its own arena at its own depth and with its root's
 //! measure as the top priced it ([`Builder::build_subtree_into`]); [`Bvh::graft_with`] splices
-//! them in and re-lays the nodes out in the single-threaded order, copying on all threads. The result is the single-threaded tree node for node, which the
-//! tests check. Scenes build their local BVHs and the fallback BVH concurrently.
+//! them in and re-lays the nodes out in the single-threaded order, copying on all threads. The
+//! result is the single-threaded tree node for node, which the tests check. Scenes build their
+//! local BVHs and the fallback BVH concurrently.
 //!
 //! The serial part is kept small: the triangle bounds are loaded in parallel parts
 //! ([`BuildArena::load_triangles_with`]), and the top nodes, each a pass over many primitives,

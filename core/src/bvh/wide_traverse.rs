@@ -131,7 +131,8 @@ impl WideBvh {
     }
 
     /// [`WideBvh::closest_hit`], adding what it did to `stats` (a wide node counts as one inner
-    /// node, a leaf's triangles as tested whatever their lanes decide).
+    /// node, a leaf's triangles as tested whatever their lanes decide; a ray that passes the
+    /// root's box by visits none: see `WideBvh::misses_root`).
     ///
     /// The loop keeps the node it is in rather than pushing and popping it: a node with one child
     /// hit goes straight on to it, and one with several pushes all but the nearest, farthest first.

@@ -184,9 +184,10 @@ impl PahPerspective {
 
     /// The measures of four boxes in front of the eye, each by the rule its own distance allows:
     /// the corrected midpoint rule for the `far` lanes (as good as exact there, see
-    /// `far_field4`), the exact formula for the others; lanes in `skip` are not needed. The rule is chosen per lane,
-    /// so a box's measure never depends on the boxes that share its group (a sweep's padding, a
-    /// threaded build's different neighbours): a group that mixes the two evaluates both.
+    /// `far_field4`), the exact formula for the others; lanes in `skip` are not needed. The rule
+    /// is chosen per lane, so a box's measure never depends on the boxes that share its group (a
+    /// sweep's padding, a threaded build's different neighbours): a group that mixes the two
+    /// evaluates both.
     #[inline(always)]
     fn by_distance4(
         &self,

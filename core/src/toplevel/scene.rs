@@ -19,8 +19,9 @@ const EXIT_OVERLAP: f32 = 1e-5;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SceneOptions {
     /// The preset of every local BVH: `pah` by default (binned SAH pricing its cuts with the
-    /// area's PAH), whose local trees cost least per ray on average over the thesis's
-    /// configurations; the thesis's own `full` (PAH + SPFH) is costlier on architectural scenes.
+    /// area's PAH), whose local trees cost less per ray on average than `sah`'s and the thesis's
+    /// `full` (PAH + SPFH) over the thesis's configurations; `full` is costlier on architectural
+    /// scenes.
     pub preset: Preset,
     /// Settings of the local builds.
     pub local: PresetOptions,

@@ -195,6 +195,14 @@ fn bad_areas_are_one_line_errors() {
             needle,
         );
     }
+    // A byte that is not UTF-8 is located by its line, like every other area-file error.
+    let latin1 = dir.join("latin1.toml");
+    std::fs::write(&latin1, [plane("1.0").as_bytes(), b"# caf\xe9\n"].concat()).unwrap();
+    fails(
+        &bin,
+        &["build", "builtin:room", "--areas", latin1.to_str().unwrap()],
+        "latin1.toml line 8: cannot read: not UTF-8",
+    );
     // An option the chosen lookup would ignore is refused, not ignored.
     let areas = dir.join("ok.toml");
     std::fs::write(&areas, plane("1.0")).unwrap();
@@ -300,4 +308,54 @@ fn a_bom_is_not_part_of_the_first_vertex_and_an_experiment_checks_its_folder_fir
         &[&args[..], &["--columns", "index"]].concat(),
         "--columns",
     );
+}
+
+/// Found by black-box testing: an output that was a hard link to the rays, or the scene's own
+/// material library, was written over. Both are inputs and fail before anything is written.
+#[test]
+fn an_output_is_never_an_input_under_another_name() {
+    let Some(bin) = binary() else { return };
+    let dir = scratch("same-file");
+    let obj = dir.join("lit.obj");
+    std::fs::write(
+        &obj,
+        "mtllib lit.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl lamp\nf 1 2 3\n",
+    )
+    .unwrap();
+    let mtl = dir.join("lit.mtl");
+    let mtl_text = "newmtl lamp\nKe 1 1 1\n";
+    std::fs::write(&mtl, mtl_text).unwrap();
+    let rays = dir.join("rays.csv");
+    let rays_text = "ox,oy,oz,dx,dy,dz\n0.2,0.2,-1,0,0,1\n";
+    std::fs::write(&rays, rays_text).unwrap();
+    let linked = dir.join("linked.csv");
+    let _ = std::fs::remove_file(&linked);
+    std::fs::hard_link(&rays, &linked).unwrap();
+    let (o, r) = (obj.to_str().unwrap(), rays.to_str().unwrap());
+    for out in [&linked, &mtl] {
+        let out = out.to_str().unwrap();
+        fails(
+            &bin,
+            &["trace", o, "--rays", r, "--out", out],
+            "input files",
+        );
+    }
+    assert_eq!(std::fs::read_to_string(&rays).unwrap(), rays_text);
+    assert_eq!(std::fs::read_to_string(&mtl).unwrap(), mtl_text);
+    // The material library is an input of analyze's --nodes too.
+    let areas = dir.join("areas.toml");
+    std::fs::write(
+        &areas,
+        "[[area]]\nkind = \"plane\"\ncenter = [0.2, 0.2, -1.0]\nnormal = [0.0, 0.0, 1.0]\n\
+         half_width = 1.0\nhalf_height = 1.0\ndepth = 3.0\n",
+    )
+    .unwrap();
+    let a = areas.to_str().unwrap();
+    let m = mtl.to_str().unwrap();
+    fails(
+        &bin,
+        &["analyze", o, "--areas", a, "--nodes", m],
+        "input files",
+    );
+    assert_eq!(std::fs::read_to_string(&mtl).unwrap(), mtl_text);
 }

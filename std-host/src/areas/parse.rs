@@ -28,11 +28,19 @@ struct RawFile {
 
 /// Reads and checks the area file at `path`.
 pub fn read_areas(path: &Path) -> Result<AreaFile, AreasError> {
-    let text = fs::read_to_string(path).map_err(|e| AreasError {
+    let fail = |line, e| AreasError {
         path: path.to_path_buf(),
-        line: None,
+        line,
         entry: None,
         kind: AreasErrorKind::Io(e),
+    };
+    let bytes = fs::read(path).map_err(|e| fail(None, e))?;
+    let text = crate::text_lines::utf8_text(bytes).map_err(|at| {
+        let why = format!("not UTF-8 text: byte {} is not UTF-8", at.byte);
+        fail(
+            Some(at.line),
+            std::io::Error::new(std::io::ErrorKind::InvalidData, why),
+        )
     })?;
     parse_areas(&text, path)
 }

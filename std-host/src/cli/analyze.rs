@@ -335,7 +335,7 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
             ));
         }
     }
-    let (scene, _) = load_scene(&args.scene)?;
+    let (scene, _) = load_scene(&args.scene, args.nodes.as_deref())?;
     let entries = load_areas(&args.areas, &scene)?;
     // Read again for its [settings] (load_areas has read it whole already).
     let text = std::fs::read_to_string(&args.areas)

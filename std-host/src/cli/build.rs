@@ -88,7 +88,7 @@ pub struct BuildReport {
 /// Runs `rdbvh build`, writing the report to `out`.
 pub fn run(args: &BuildArgs, out: &mut impl Write) -> Result<(), CliError> {
     args.builder.check_area(args.areas.is_some())?;
-    let (scene, load_seconds) = load_scene(&args.scene)?;
+    let (scene, load_seconds) = load_scene(&args.scene, None)?;
     let area = match &args.areas {
         Some(path) => {
             let entries = load_areas(path, &scene)?;

@@ -56,7 +56,10 @@ impl ValueEnum for PresetArg {
     fn to_possible_value(&self) -> Option<PossibleValue> {
         let help = match self.0 {
             Preset::Sah => "binned SAH over all three axes (no area needed)",
-            Preset::Standard => "SAH + longest axis (LSPH), the thesis's standard (no area needed)",
+            Preset::Standard => {
+                "SAH + longest axis (LSPH) with the thesis's cut rule, the thesis's standard \
+                 (no area needed)"
+            }
             Preset::Facing => "SAH + splitting plane facing (SPFH); needs --areas",
             Preset::Longest => "PAH + LSPH; needs --areas",
             Preset::Full => "PAH + SPFH, the thesis's full method; needs --areas",

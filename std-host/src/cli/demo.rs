@@ -45,7 +45,7 @@ pub fn run(out: &mut impl Write) -> Result<(), CliError> {
     )?;
     let mut checked = 0;
     for spec in ["builtin:room", "builtin:random1000"] {
-        let (scene, load_s) = load_scene(spec)?;
+        let (scene, load_s) = load_scene(spec, None)?;
         w(
             out,
             format!(
@@ -128,7 +128,7 @@ pub fn room_light_area() -> Result<InfluenceArea, CliError> {
 /// the area's rays and unrelated rays through it, and returns how many queries it checked.
 fn structure(out: &mut impl Write) -> Result<usize, CliError> {
     let w = |out: &mut dyn Write, text: String| writeln!(out, "{text}").map_err(CliError::Stdout);
-    let (scene, _) = load_scene("builtin:room")?;
+    let (scene, _) = load_scene("builtin:room", None)?;
     let area = room_light_area()?;
     let options = SceneOptions {
         preset: Preset::Full,

@@ -28,7 +28,10 @@ Presets (--preset NAME; the thesis's four pairs, and this project's sah and pah)
   pah        PAH over all three axes (sah's builder)   needs --areas
 --thesis-mode builds as the thesis did: 41 bins over the node box, leaves of at most 2 triangles by
 size alone; --bins and --max-leaf still override it. --builder sah|lsph is the plain binned SAH
-builder (all axes, or the longest axis only); it and --preset exclude each other.";
+builder (all axes, or the longest axis only); it and --preset exclude each other. The thesis cut
+rule of standard, facing, longest and full tries the chooser's axes in order, also the next ones
+when they are nearly as good, accepts a good split early and falls back to SAH on the longest
+axis; so --preset standard and --builder lsph build different trees.";
 
 const AREAS: &str = "\
 Area files (TOML): one [[area]] table per influence area, with the keys of an experiments.toml
@@ -68,7 +71,8 @@ pub fn build() -> String {
          --json prints one object with the keys scene, triangles (in the build), scene_triangles,\n\
          nodes, leaves, max_depth, sah_cost, pah_cost, bytes, load_ms, select_ms, build_ms,\n\
          reinsert_ms, reinsert_moved, mtris_per_s, threads, builder, preset, thesis_mode,\n\
-         area_kind, bins, max_leaf (null where they do not apply).\n\n\
+         area_kind, bins, max_leaf (null where they do not apply, and for a cost that is NaN:\n\
+         coordinates of about 1e19 or more overflow box areas).\n\n\
          {AREAS}\n\n\
          Examples:\n  \
          rdbvh build scene.obj --preset sah --json\n  \

@@ -135,15 +135,48 @@ fn check_output(path: &std::path::Path, inputs: &[&std::path::Path]) -> Result<(
     if !folder.is_dir() {
         return Err(fail("its folder does not exist"));
     }
-    if let Ok(out) = path.canonicalize() {
-        if inputs
-            .iter()
-            .any(|i| i.canonicalize().is_ok_and(|i| i == out))
-        {
-            return Err(fail("it is one of the command's input files"));
+    check_not_input(path, inputs.iter().copied())
+}
+
+/// Fails when the output `path` is the same file as one of `inputs`: the same path, a symbolic
+/// link to it, or a hard link to it.
+fn check_not_input<'a>(
+    path: &std::path::Path,
+    inputs: impl IntoIterator<Item = &'a std::path::Path>,
+) -> Result<(), CliError> {
+    match inputs.into_iter().find(|input| same_file(path, input)) {
+        Some(input) => Err(CliError::Write {
+            path: path.to_path_buf(),
+            source: io::Error::new(
+                io::ErrorKind::AlreadyExists,
+                format!(
+                    "it is one of the command's input files ({})",
+                    input.display()
+                ),
+            ),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Whether two paths name one existing file: the same device and inode where the platform has
+/// them (which catches hard links), the same canonical path elsewhere.
+fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        match (std::fs::metadata(a), std::fs::metadata(b)) {
+            (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+            _ => false,
         }
     }
-    Ok(())
+    #[cfg(not(unix))]
+    {
+        match (a.canonicalize(), b.canonicalize()) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => false,
+        }
+    }
 }
 
 /// `n` things in words: "1 thread", "2 threads".
@@ -167,11 +200,15 @@ fn one_line(message: &str) -> String {
 }
 
 /// Opens a scene (a path or `builtin:NAME`), prints its warnings to standard error, and returns
-/// it with the seconds it took.
-fn load_scene(spec: &str) -> Result<(Scene, f64), CliError> {
+/// it with the seconds it took. Fails when `output` (checked by [`check_output`] already) is one
+/// of the material libraries the scene read: those are inputs too, known only once read.
+fn load_scene(spec: &str, output: Option<&std::path::Path>) -> Result<(Scene, f64), CliError> {
     let start = Instant::now();
     let scene = Scene::open(spec)?;
     let seconds = start.elapsed().as_secs_f64();
+    if let Some(output) = output {
+        check_not_input(output, scene.material_files.iter().map(|p| p.as_path()))?;
+    }
     for w in &scene.warnings {
         eprintln!("warning: {}: {w}", scene.name);
     }

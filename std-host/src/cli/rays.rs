@@ -257,8 +257,8 @@ fn read_rows<R: Read>(
         let at = bytes.position().map(|p| p.byte());
         if bytes.len() != columns.fields {
             let reason = format!(
-                "has {} fields, but the header has {}",
-                bytes.len(),
+                "has {}, but the header has {}",
+                super::count(bytes.len(), "field"),
                 columns.fields
             );
             return Err(fail(at, rays.len(), false, reason));
@@ -321,7 +321,10 @@ fn csv_reason(e: &csv::Error) -> String {
     match e.kind() {
         csv::ErrorKind::UnequalLengths {
             expected_len, len, ..
-        } => format!("has {len} fields, but the header has {expected_len}"),
+        } => format!(
+            "has {}, but the header has {expected_len}",
+            super::count(usize::try_from(*len).unwrap_or(usize::MAX), "field")
+        ),
         csv::ErrorKind::Utf8 { .. } => "not valid UTF-8".to_string(),
         csv::ErrorKind::Io(io) => format!("cannot read: {io}"),
         _ => e.to_string(),

@@ -155,7 +155,8 @@ fn fallback_alone(
             }
             f64::from(s.cost(k))
         })
-        .sum()
+        // From +0.0: the standard float sum of no rays is -0.0, which prints as "-0.00".
+        .reduce(|| 0.0, |a, b| a + b)
 }
 
 /// The scene-structure options of a command line: the local preset (`pah` unless --preset says
@@ -186,7 +187,7 @@ pub fn run(args: &TraceArgs, areas_path: &Path, log: &mut impl Write) -> Result<
             "--octree-levels sizes the octree lookup; --lookup list has no levels".into(),
         ));
     }
-    let (scene, _) = load_scene(&args.scene)?;
+    let (scene, _) = load_scene(&args.scene, Some(&args.out))?;
     let entries = load_areas(areas_path, &scene)?;
     let rays = read_rays(&args.rays)?;
     let areas: Vec<_> = entries.iter().map(|e| e.area).collect();
@@ -203,8 +204,11 @@ pub fn run(args: &TraceArgs, areas_path: &Path, log: &mut impl Write) -> Result<
             let build_seconds = start.elapsed().as_secs_f64();
             let o = s.lookup().stats();
             let lookup = format!(
-                "octree of {levels} levels ({} used, {} nodes, {} leaves)",
-                o.levels, o.nodes, o.leaves
+                "octree of {} ({} used, {} nodes, {} leaves)",
+                super::count(levels as usize, "level"),
+                o.levels,
+                o.nodes,
+                o.leaves
             );
             finish(args, &scene, &rays, &s, &lookup, build_seconds, log)
         }

@@ -165,7 +165,7 @@ pub fn run(args: &TraceArgs, log: &mut impl Write) -> Result<(), CliError> {
         return structure::run(args, areas, log);
     }
     args.builder.check_area(false)?;
-    let (scene, _) = load_scene(&args.scene)?;
+    let (scene, _) = load_scene(&args.scene, Some(&args.out))?;
     let rays = read_rays(&args.rays)?;
     // Queries run on the 4-wide collapse of the built tree: the same answers, faster.
     let built = args.builder.build_for_wide(&scene.triangles)?;

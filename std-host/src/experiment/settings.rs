@@ -270,8 +270,9 @@ pub struct ExperimentFile {
 impl ExperimentFile {
     /// Reads and checks an experiment file.
     pub fn read(path: &Path) -> Result<Self, ExperimentError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| ExperimentError::Io(path.to_path_buf(), e.to_string()))?;
+        let io = |why: String| ExperimentError::Io(path.to_path_buf(), why);
+        let bytes = std::fs::read(path).map_err(|e| io(e.to_string()))?;
+        let text = crate::text_lines::utf8_text(bytes).map_err(|at| io(at.to_string()))?;
         Self::parse(&text, path)
     }
 

@@ -54,6 +54,9 @@ pub struct Scene {
     pub bounds: Aabb,
     /// What the loader tolerated (missing material libraries, skipped lines).
     pub warnings: Vec<SceneWarning>,
+    /// The material library files that were read from disk, so that a command can refuse to
+    /// write its output over one. Empty for built-in and in-memory scenes.
+    pub material_files: Vec<std::path::PathBuf>,
 }
 
 impl Scene {

@@ -125,6 +125,7 @@ impl Scene {
         };
 
         let warnings = RefCell::new(Vec::new());
+        let read_files = RefCell::new(Vec::new());
         let options = tobj::LoadOptions {
             triangulate: true,
             ignore_points: true,
@@ -133,7 +134,7 @@ impl Scene {
         };
         let load = |text: &str| {
             tobj::load_obj_buf(&mut text.as_bytes(), &options, |name| {
-                load_mtl(name, materials, &warnings)
+                load_mtl(name, materials, &warnings, &read_files)
             })
         };
         let loaded = match load(&text) {
@@ -141,6 +142,7 @@ impl Scene {
             // unused here, so they go and the text loads again.
             Err(tobj::LoadError::FaceColorOutOfBounds) => {
                 warnings.borrow_mut().clear();
+                read_files.borrow_mut().clear();
                 load(&sanitized(&text, true))
             }
             other => other,
@@ -242,6 +244,7 @@ impl Scene {
             materials,
             bounds,
             warnings,
+            material_files: read_files.into_inner(),
         })
     }
 }
@@ -249,16 +252,9 @@ impl Scene {
 /// The file's bytes as text, or an [`SceneError::Io`] (invalid data) naming the line and byte of
 /// the first one that is not UTF-8 (the standard library's message names neither).
 fn utf8_text(bytes: Vec<u8>, label: &Path) -> Result<String, SceneError> {
-    String::from_utf8(bytes).map_err(|e| {
-        let at = e.utf8_error().valid_up_to();
-        let line = e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count() + 1;
-        SceneError::Io {
-            path: label.to_path_buf(),
-            source: std::io::Error::new(
-                std::io::ErrorKind::InvalidData,
-                format!("not UTF-8 text: line {line} (byte {at}) holds a byte that is not UTF-8"),
-            ),
-        }
+    crate::text_lines::utf8_text(bytes).map_err(|at| SceneError::Io {
+        path: label.to_path_buf(),
+        source: std::io::Error::new(std::io::ErrorKind::InvalidData, at.to_string()),
     })
 }
 
@@ -530,10 +526,16 @@ fn load_mtl(
     name: &Path,
     files: MaterialFiles<'_>,
     warnings: &RefCell<Vec<SceneWarning>>,
+    read_files: &RefCell<Vec<PathBuf>>,
 ) -> tobj::MTLLoadResult {
     let (path, text) = files.read(name);
     let text = match text {
-        Ok(text) => text,
+        Ok(text) => {
+            if let MaterialFiles::Folder(_) = files {
+                read_files.borrow_mut().push(path.clone());
+            }
+            text
+        }
         Err(reason) => {
             warnings
                 .borrow_mut()

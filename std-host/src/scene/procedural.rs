@@ -51,6 +51,7 @@ pub(super) fn random_scene(name: &str, skip: usize, count: usize) -> Scene {
         materials: Vec::new(),
         bounds,
         warnings: Vec::new(),
+        material_files: Vec::new(),
         triangles,
     }
 }

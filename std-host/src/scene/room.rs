@@ -68,6 +68,7 @@ pub fn room() -> Scene {
         emissive,
         materials,
         warnings: Vec::new(),
+        material_files: Vec::new(),
     }
 }
 

@@ -359,3 +359,125 @@ fn an_output_is_never_an_input_under_another_name() {
     );
     assert_eq!(std::fs::read_to_string(&mtl).unwrap(), mtl_text);
 }
+
+/// Found by black-box testing: an experiment whose --out folder held one of its inputs under an
+/// output's name (the experiment file as `report.md`, a scene as `results.csv`, its material
+/// library as a chart) deleted it and wrote its results in its place. Each fails before any run,
+/// and the input is kept.
+#[test]
+fn an_experiment_never_writes_over_its_inputs() {
+    let Some(bin) = binary() else { return };
+    let out = scratch("experiment-inputs");
+    let config = "[[config]]\nkind = \"plane\"\ncenter = [0.2, 0.2, -1.0]\n\
+                  normal = [0.0, 0.0, 1.0]\nhalf_width = 1.0\nhalf_height = 1.0\ndepth = 3.0\n";
+    let experiment = |file: &str| {
+        format!(
+            "[settings]\nrays_per_config = 10\nheuristics = [\"sah\"]\n{config}file = \"{file}\"\n"
+        )
+    };
+    let scene = "mtllib lit.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl lamp\nf 1 2 3\n";
+    std::fs::write(out.join("lit.obj"), scene).unwrap();
+    let mtl = "newmtl lamp\nKe 1 1 1\n";
+    std::fs::write(out.join("lit.mtl"), mtl).unwrap();
+    let o = out.to_str().unwrap();
+
+    // The experiment file itself, as report.md.
+    let report = out.join("report.md");
+    std::fs::write(&report, experiment("lit.obj")).unwrap();
+    let r = report.to_str().unwrap();
+    fails(&bin, &["experiment", r, "--out", o], "input files");
+    assert_eq!(
+        std::fs::read_to_string(&report).unwrap(),
+        experiment("lit.obj")
+    );
+    std::fs::remove_file(&report).unwrap();
+
+    // A scene named results.csv, and a material library hard-linked as a chart.
+    let file = out.join("e.toml");
+    let e = file.to_str().unwrap();
+    std::fs::write(out.join("results.csv"), scene).unwrap();
+    std::fs::write(&file, experiment("results.csv")).unwrap();
+    fails(&bin, &["experiment", e, "--out", o], "input files");
+    assert_eq!(
+        std::fs::read_to_string(out.join("results.csv")).unwrap(),
+        scene
+    );
+    let chart = out.join("estimate_error.png");
+    let _ = std::fs::remove_file(&chart);
+    std::fs::hard_link(out.join("lit.mtl"), &chart).unwrap();
+    std::fs::write(&file, experiment("lit.obj")).unwrap();
+    fails(&bin, &["experiment", e, "--out", o], "input files");
+    assert_eq!(std::fs::read_to_string(out.join("lit.mtl")).unwrap(), mtl);
+    std::fs::remove_file(&chart).unwrap();
+
+    // With the names free, the same experiment runs.
+    succeeds(&bin, &["experiment", e, "--out", o]);
+    assert_eq!(std::fs::read_to_string(out.join("lit.mtl")).unwrap(), mtl);
+    assert!(std::fs::read_to_string(out.join("report.md"))
+        .unwrap()
+        .starts_with('#'));
+}
+
+/// Found by black-box testing: some experiment-file errors named neither the file nor the line.
+#[test]
+fn experiment_errors_name_the_file_and_line() {
+    let Some(bin) = binary() else { return };
+    let dir = scratch("experiment-lines");
+    let out = dir.join("out");
+    let (o, file) = (out.to_str().unwrap(), dir.join("e.toml"));
+    let e = file.to_str().unwrap();
+    let config = "[[config]]\nkind = \"plane\"\ncenter = [0.2, 0.2, -1.0]\n\
+                  normal = [0.0, 0.0, 1.0]\nhalf_width = 1.0\nhalf_height = 1.0\ndepth = 3.0\n";
+    for (settings, needle) in [
+        (
+            "heuristics = [\"full\", \"bogus\"]",
+            "e.toml line 3: `heuristics` lists unknown heuristic `bogus`",
+        ),
+        (
+            "heuristics = []",
+            "e.toml line 3: `heuristics` lists no heuristic",
+        ),
+    ] {
+        let text =
+            format!("[settings]\nrays_per_config = 10\n{settings}\n{config}file = \"a.obj\"\n");
+        std::fs::write(&file, text).unwrap();
+        fails(&bin, &["experiment", e, "--out", o], needle);
+    }
+    // A scene file that cannot be read is named with the configuration that wants it.
+    let text = format!("[settings]\nrays_per_config = 10\n{config}file = \"a.obj\"\n{config}file = \"absent.obj\"\n");
+    std::fs::write(&file, text).unwrap();
+    std::fs::write(dir.join("a.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    fails(
+        &bin,
+        &["experiment", e, "--out", o],
+        "e.toml line 11: config 1: cannot read scene",
+    );
+    assert!(!out.join("results.csv").exists());
+    // So is a bad --thesis-results folder, before any run.
+    std::fs::write(&file, format!("{config}file = \"a.obj\"\n")).unwrap();
+    let empty = dir.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let t = empty.to_str().unwrap();
+    fails(
+        &bin,
+        &["experiment", e, "--out", o, "--thesis-results", t],
+        "no Plane_*.csv or Point_*.csv",
+    );
+    assert!(!out.join("results.csv").exists());
+    // And analyze's --columns names each column once.
+    let a = dir.join("a.obj");
+    let args = [
+        "analyze",
+        a.to_str().unwrap(),
+        "--areas",
+        e,
+        "--columns",
+        "index,index",
+    ];
+    let nodes = dir.join("nodes.csv");
+    fails(
+        &bin,
+        &[&args[..], &["--nodes", nodes.to_str().unwrap()]].concat(),
+        "`index` appears twice",
+    );
+}

@@ -113,12 +113,23 @@ fn setup(args: &AnalyzeArgs, file: &Settings) -> RunSetup {
     }
 }
 
+/// An `f32` as JSON by its shortest decimal, as the CSV export and the table write it (`json!`
+/// widens it to `f64` first, which writes 20.73 as 20.729999542236328); `null` for NaN and
+/// infinity, as `json!` gives.
+fn real(x: f32) -> Value {
+    x.to_string()
+        .parse::<f64>()
+        .ok()
+        .and_then(serde_json::Number::from_f64)
+        .map_or(Value::Null, Value::Number)
+}
+
 fn levels_json(v: &[f32]) -> Value {
     Value::Object(
         THESIS_LEVELS
             .iter()
             .zip(v)
-            .map(|(l, x)| (l.to_string(), json!(x)))
+            .map(|(l, &x)| (l.to_string(), real(x)))
             .collect(),
     )
 }
@@ -138,12 +149,12 @@ fn metrics_json(area: usize, kind: &str, m: &RunMetrics, error: f32) -> Value {
     put("leaves", json!(m.shape.leaves));
     put("max_depth", json!(m.shape.max_depth));
     put("levels", json!(m.shape.levels()));
-    put("mean_leaf_depth", json!(m.shape.mean_leaf_depth));
+    put("mean_leaf_depth", real(m.shape.mean_leaf_depth));
     put("leaf_sizes", json!(m.shape.leaf_sizes));
-    put("sah_cost", json!(m.sah));
-    put("pah_cost", json!(m.pah));
-    put("pah_cost_relative_to_root", json!(m.pah_root));
-    put("epo", json!(m.epo));
+    put("sah_cost", real(m.sah));
+    put("pah_cost", real(m.pah));
+    put("pah_cost_relative_to_root", real(m.pah_root));
+    put("epo", real(m.epo));
     put("overlap_3d", json!(levels_json(&m.overlap_3d)));
     put(
         "overlap_projected",
@@ -151,42 +162,42 @@ fn metrics_json(area: usize, kind: &str, m: &RunMetrics, error: f32) -> Value {
     );
     put("overlap_culled", json!(levels_json(&m.overlap_culled)));
     put("rays", json!(c.rays));
-    put("all_hit_cost_with_fallback", json!(c.all_hit_structure));
-    put("all_hit_cost_without_fallback", json!(c.all_hit_local));
+    put("all_hit_cost_with_fallback", real(c.all_hit_structure));
+    put("all_hit_cost_without_fallback", real(c.all_hit_local));
     put(
         "all_hit_cost_fallback_part_when_fell_back",
-        json!(c.all_hit_fallback_when_fell_back),
+        real(c.all_hit_fallback_when_fell_back),
     );
     put(
         "all_hit_cost_fallback_alone",
-        json!(c.all_hit_fallback_alone),
+        real(c.all_hit_fallback_alone),
     );
     put(
         "intersections_with_fallback",
-        json!(c.intersections_structure),
+        real(c.intersections_structure),
     );
     put(
         "intersections_without_fallback",
-        json!(c.intersections_local),
+        real(c.intersections_local),
     );
-    put("local_hit_rate", json!(c.local_hit_rate));
+    put("local_hit_rate", real(c.local_hit_rate));
     put(
         "closest_hit_cost_with_fallback",
-        json!(c.closest_hit_structure),
+        real(c.closest_hit_structure),
     );
     put(
         "closest_hit_cost_without_fallback",
-        json!(c.closest_hit_local),
+        real(c.closest_hit_local),
     );
     put(
         "closest_hit_cost_fallback_alone",
-        json!(c.closest_hit_fallback_alone),
+        real(c.closest_hit_fallback_alone),
     );
-    put("closest_hit_local_rate", json!(c.closest_hit_local_rate));
-    put("any_hit_cost_with_fallback", json!(c.any_hit_structure));
+    put("closest_hit_local_rate", real(c.closest_hit_local_rate));
+    put("any_hit_cost_with_fallback", real(c.any_hit_structure));
     put(
         "any_hit_cost_fallback_alone",
-        json!(c.any_hit_fallback_alone),
+        real(c.any_hit_fallback_alone),
     );
     put("rays_per_second", json!(m.rays_per_second));
     put(
@@ -195,11 +206,11 @@ fn metrics_json(area: usize, kind: &str, m: &RunMetrics, error: f32) -> Value {
     );
     put("local_bvh_bytes", json!(m.shape.memory_bytes));
     put("fallback_bvh_bytes", json!(m.fallback_bytes));
-    put("fallback_sah_cost", json!(m.fallback_sah));
+    put("fallback_sah_cost", real(m.fallback_sah));
     put("octree_levels", json!(m.octree.levels));
     put("octree_leaves", json!(m.octree.leaves));
     put("octree_bytes", json!(m.octree.bytes));
-    put("octree_containment_error", json!(error));
+    put("octree_containment_error", real(error));
     put("area_bytes", json!(m.area_bytes));
     Value::Object(o)
 }
@@ -262,7 +273,7 @@ impl Field {
     fn json(&self) -> Value {
         match self {
             Field::Int(v) => json!(v),
-            Field::Real(v) => json!(v),
+            Field::Real(v) => real(*v),
             Field::Flag(v) => json!(v),
             Field::Missing => Value::Null,
         }
@@ -298,16 +309,7 @@ fn write_nodes(
             .map_err(|e| fail(std::io::Error::other(e)))?;
         return std::fs::write(path, text).map_err(fail);
     }
-    let cols: Vec<String> = match columns {
-        Some(c) => c.iter().map(|s| s.trim().to_string()).collect(),
-        None => NODE_COLUMNS.iter().map(|s| s.to_string()).collect(),
-    };
-    if let Some(bad) = cols.iter().find(|c| !NODE_COLUMNS.contains(&c.as_str())) {
-        return Err(CliError::Usage(format!(
-            "unknown node column `{bad}` (expected {})",
-            NODE_COLUMNS.join(", ")
-        )));
-    }
+    let cols = node_columns(columns)?;
     let mut text = cols.join(",");
     text.push('\n');
     for r in records {
@@ -318,6 +320,28 @@ fn write_nodes(
     std::fs::write(path, text).map_err(fail)
 }
 
+/// The CSV export's columns: `--columns` checked (each a known column, none twice), or all.
+fn node_columns(columns: Option<&[String]>) -> Result<Vec<String>, CliError> {
+    let cols: Vec<String> = match columns {
+        Some(c) => c.iter().map(|s| s.trim().to_string()).collect(),
+        None => NODE_COLUMNS.iter().map(|s| s.to_string()).collect(),
+    };
+    for (i, col) in cols.iter().enumerate() {
+        if !NODE_COLUMNS.contains(&col.as_str()) {
+            return Err(CliError::Usage(format!(
+                "unknown node column `{col}` (expected {})",
+                NODE_COLUMNS.join(", ")
+            )));
+        }
+        if cols[..i].contains(col) {
+            return Err(CliError::Usage(format!(
+                "node column `{col}` appears twice in --columns"
+            )));
+        }
+    }
+    Ok(cols)
+}
+
 /// Builds and analyses; prints a table (or JSON) to `out`.
 pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
     let preset = Preset::from_name(&args.preset).ok_or_else(|| {
@@ -326,6 +350,8 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
             args.preset
         ))
     })?;
+    // Before any work, as clap's own checks are: a bad column must not wait for the analysis.
+    node_columns(args.columns.as_deref())?;
     if let Some(nodes) = &args.nodes {
         super::check_output(nodes, &[Path::new(&args.scene), args.areas.as_path()])?;
         if args.columns.is_some() && is_json(nodes) {

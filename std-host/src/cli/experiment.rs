@@ -89,8 +89,8 @@ pub fn run(args: &ExperimentArgs, out: &mut dyn Write) -> Result<(), CliError> {
     let w = |e| CliError::Stdout(e);
     writeln!(
         out,
-        "{} runs in {:.1} s -> {}",
-        s.rows.len(),
+        "{} in {:.1} s -> {}",
+        super::count(s.rows.len(), "run"),
         s.seconds,
         args.out.join("results.csv").display()
     )

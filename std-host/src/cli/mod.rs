@@ -144,7 +144,7 @@ fn check_not_input<'a>(
     path: &std::path::Path,
     inputs: impl IntoIterator<Item = &'a std::path::Path>,
 ) -> Result<(), CliError> {
-    match inputs.into_iter().find(|input| same_file(path, input)) {
+    match crate::same_file::input_named_by(path, inputs) {
         Some(input) => Err(CliError::Write {
             path: path.to_path_buf(),
             source: io::Error::new(
@@ -156,26 +156,6 @@ fn check_not_input<'a>(
             ),
         }),
         None => Ok(()),
-    }
-}
-
-/// Whether two paths name one existing file: the same device and inode where the platform has
-/// them (which catches hard links), the same canonical path elsewhere.
-fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        match (std::fs::metadata(a), std::fs::metadata(b)) {
-            (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
-            _ => false,
-        }
-    }
-    #[cfg(not(unix))]
-    {
-        match (a.canonicalize(), b.canonicalize()) {
-            (Ok(a), Ok(b)) => a == b,
-            _ => false,
-        }
     }
 }
 

@@ -41,14 +41,16 @@ mod toplevel_study;
 
 pub use error::ExperimentError;
 pub use plots::fonts_available;
-pub use results::{header, read_table, read_thesis_results, RunRow, Table, THESIS_COLUMNS};
+pub use results::{
+    header, read_table, read_thesis_results, thesis_result_files, RunRow, Table, THESIS_COLUMNS,
+};
 pub use run::{build_fallback, run_one, sample_rays, RunMetrics, RunSetup};
 pub use settings::{parse_presets, settings_of, ExperimentFile, Settings, MAX_CANDIDATE_PLANES};
 pub use summary::{cheaper_groups, findings, pair_thesis, Findings, Pairing, RunKey, GROUPS};
 
 use std::collections::HashMap;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -199,6 +201,17 @@ pub fn run_key(entry: &AreaEntry, preset: Preset) -> RunKey {
     }
 }
 
+/// Where a configuration is written, as an error's prefix: `FILE line N: config I: ` (`I`
+/// counted from 0, as the area files' errors count).
+fn config_at(file: &ExperimentFile, entry: &AreaEntry) -> String {
+    format!(
+        "{} line {}: config {}: ",
+        file.path.display(),
+        entry.line,
+        entry.index
+    )
+}
+
 /// Runs an experiment, writing `results.csv`, `report.md` and the charts into `opts.out`; notes
 /// (skipped configurations) go to `log`.
 pub fn run_experiment(
@@ -230,6 +243,12 @@ pub fn run_experiment(
             "octree_levels must be at least 1".into(),
         ));
     }
+    // The thesis's results before any run: a folder that cannot be read fails in a moment, not
+    // after the runs, and its files join the inputs that no output may be.
+    let thesis_results = match &opts.thesis_results {
+        Some(dir) => Some((read_thesis_results(dir)?, thesis_result_files(dir)?)),
+        None => None,
+    };
     // The output folder first: a path that cannot be one fails before the runs, not after.
     if opts.out.exists() && !opts.out.is_dir() {
         return Err(ExperimentError::Io(
@@ -279,7 +298,7 @@ pub fn run_experiment(
                 let name = e
                     .scene
                     .clone()
-                    .unwrap_or_else(|| format!("config {}", e.index + 1));
+                    .unwrap_or_else(|| format!("config {}", e.index));
                 match missing.iter_mut().find(|(n, _)| *n == name) {
                     Some((_, c)) => *c += 1,
                     None => missing.push((name, 1)),
@@ -300,14 +319,40 @@ pub fn run_experiment(
     let loaded: Vec<(PathBuf, Arc<Scene>, Arc<rdbvh_core::bvh::Bvh>)> = paths
         .par_iter()
         .map(|p| {
-            let scene = Scene::open(&p.to_string_lossy())
-                .map_err(|e| ExperimentError::Scene(e.to_string()))?;
+            let scene = Scene::open(&p.to_string_lossy()).map_err(|e| {
+                // Named by the first configuration that wants it, so the file can be fixed.
+                let at = runnable
+                    .iter()
+                    .find(|(_, q)| q == p)
+                    .map(|(e, _)| config_at(&file, e))
+                    .unwrap_or_default();
+                ExperimentError::Scene(format!("{at}{e}"))
+            })?;
             let fallback = build_fallback(&scene.triangles, &setup)?;
             Ok((p.clone(), Arc::new(scene), Arc::new(fallback)))
         })
         .collect::<Result<_, ExperimentError>>()?;
     let scenes: HashMap<PathBuf, (Arc<Scene>, Arc<rdbvh_core::bvh::Bvh>)> =
         loaded.into_iter().map(|(p, s, f)| (p, (s, f))).collect();
+    // A run clears its outputs before it writes them: an output that is an input, under its own
+    // name or through a link, would delete the input.
+    let mut inputs: Vec<&Path> = vec![opts.file.as_path()];
+    for (path, (scene, _)) in &scenes {
+        inputs.push(path);
+        inputs.extend(scene.material_files.iter().map(PathBuf::as_path));
+    }
+    if let Some((_, files)) = &thesis_results {
+        inputs.extend(files.iter().map(PathBuf::as_path));
+    }
+    for output in report::output_files(&opts.out) {
+        if let Some(input) = crate::same_file::input_named_by(&output, inputs.iter().copied()) {
+            let why = format!(
+                "cannot write: it is one of the experiment's input files ({})",
+                input.display()
+            );
+            return Err(ExperimentError::Io(output, why));
+        }
+    }
 
     let jobs: Vec<(usize, &AreaEntry, &PathBuf, Preset)> = runnable
         .iter()
@@ -343,9 +388,9 @@ pub fn run_experiment(
             )
             .map_err(|e| match e {
                 ExperimentError::Build(m) => ExperimentError::Build(format!(
-                    "{} (config {}): {m}",
-                    path.display(),
-                    entry.index + 1
+                    "{}{}: {m}",
+                    config_at(&file, entry),
+                    path.display()
                 )),
                 other => other,
             })?;
@@ -414,11 +459,10 @@ pub fn run_experiment(
         .collect();
     let ours_table = read_table(&results)?;
     let ours = findings(&ours_table, &keys);
-    let (thesis, pairing) = match &opts.thesis_results {
-        Some(dir) => {
-            let table = read_thesis_results(dir)?;
+    let (thesis, pairing) = match &thesis_results {
+        Some((table, _)) => {
             let (paired, pairing) =
-                pair_thesis(&table, &ours_table, &keys, settings.rays_per_config);
+                pair_thesis(table, &ours_table, &keys, settings.rays_per_config);
             (Some(findings(&paired, &keys)), Some(pairing))
         }
         None => (None, None),

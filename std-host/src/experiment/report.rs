@@ -1,7 +1,7 @@
 //! `report.md` and its charts.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::plots::{fonts_available, save, Bars, Lines};
 use super::summary::{cheaper_groups, PerGroup, GROUPS};
@@ -30,19 +30,24 @@ const CHARTS: [&str; 6] = [
     "octree_vs_list",
 ];
 
-/// Removes an earlier run's `results.csv`, `report.md` and charts from `dir`, before a run
-/// writes its own: a run stopped while writing leaves only its own files, never a new
-/// `results.csv` beside an old report.
-pub fn clear_outputs(dir: &Path) -> Result<(), ExperimentError> {
-    let files = ["results.csv".to_string(), "report.md".to_string()]
+/// Every file a run writes into `dir`: `results.csv`, `report.md` and each chart as SVG and PNG.
+pub fn output_files(dir: &Path) -> Vec<PathBuf> {
+    ["results.csv".to_string(), "report.md".to_string()]
         .into_iter()
         .chain(
             CHARTS
                 .iter()
                 .flat_map(|stem| [format!("{stem}.svg"), format!("{stem}.png")]),
-        );
-    for f in files {
-        let path = dir.join(f);
+        )
+        .map(|f| dir.join(f))
+        .collect()
+}
+
+/// Removes an earlier run's `results.csv`, `report.md` and charts from `dir`, before a run
+/// writes its own: a run stopped while writing leaves only its own files, never a new
+/// `results.csv` beside an old report.
+pub fn clear_outputs(dir: &Path) -> Result<(), ExperimentError> {
+    for path in output_files(dir) {
         match std::fs::remove_file(&path) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
                 return Err(ExperimentError::Io(path, e.to_string()))

@@ -2,7 +2,7 @@
 //! and reading the thesis's own result files back.
 
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use rdbvh_core::analyze::THESIS_LEVELS;
 
@@ -268,6 +268,16 @@ fn read_table_checked(path: &Path, numeric: bool) -> Result<Table, ExperimentErr
 
 /// Reads the thesis's `Plane_*.csv` and `Point_*.csv` files in `dir` into one table.
 pub fn read_thesis_results(dir: &Path) -> Result<Table, ExperimentError> {
+    let mut out = Table::new();
+    for f in thesis_result_files(dir)? {
+        out.extend(read_table_checked(&f, true)?);
+    }
+    Ok(out)
+}
+
+/// The thesis's result files in `dir` (`Plane_*.csv` and `Point_*.csv`), sorted; an error when
+/// there is none.
+pub fn thesis_result_files(dir: &Path) -> Result<Vec<PathBuf>, ExperimentError> {
     let entries = std::fs::read_dir(dir)
         .map_err(|e| ExperimentError::Io(dir.to_path_buf(), e.to_string()))?;
     let mut files: Vec<_> = entries
@@ -285,11 +295,7 @@ pub fn read_thesis_results(dir: &Path) -> Result<Table, ExperimentError> {
             dir.display()
         )));
     }
-    let mut out = Table::new();
-    for f in files {
-        out.extend(read_table_checked(&f, true)?);
-    }
-    Ok(out)
+    Ok(files)
 }
 
 #[cfg(test)]

@@ -167,17 +167,19 @@ impl Settings {
                 "must be finite and >= 0".into(),
             ),
         ];
-        match rules.into_iter().find(|(_, ok, _)| !ok) {
-            None => Ok(()),
-            Some((key, _, why)) => {
-                let line = settings_line(text, key)
-                    .map(|n| format!(" line {n}"))
-                    .unwrap_or_default();
-                Err(ExperimentError::Settings(format!(
-                    "{}{line}: `{key}` {why}",
-                    path.display()
-                )))
-            }
+        let at_key = |key: &str, why: &str| {
+            let line = settings_line(text, key)
+                .map(|n| format!(" line {n}"))
+                .unwrap_or_default();
+            ExperimentError::Settings(format!("{}{line}: `{key}` {why}", path.display()))
+        };
+        if let Some((key, _, why)) = rules.into_iter().find(|(_, ok, _)| !ok) {
+            return Err(at_key(key, &why));
+        }
+        // Checked even when --presets overrides them: a bad file is a bad file.
+        match self.presets() {
+            Ok(_) => Ok(()),
+            Err(e) => Err(at_key("heuristics", &format!("lists {e}"))),
         }
     }
 
@@ -187,7 +189,8 @@ impl Settings {
     }
 }
 
-/// Presets from their names (`full`, `longest`, `facing`, `standard`, `sah`), without repeats.
+/// Presets from their names (`full`, `longest`, `facing`, `standard`, `sah`, `pah`), without
+/// repeats.
 pub fn parse_presets<'a>(
     names: impl IntoIterator<Item = &'a str>,
 ) -> Result<Vec<Preset>, ExperimentError> {

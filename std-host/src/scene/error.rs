@@ -84,6 +84,8 @@ pub enum SceneError {
     NonFiniteVertex {
         /// The scene file.
         path: PathBuf,
+        /// 1-based line of the vertex, when found.
+        line: Option<usize>,
         /// 0-based triangle index in load order.
         triangle: usize,
         /// Which corner of the triangle (0, 1 or 2).
@@ -130,18 +132,23 @@ impl fmt::Display for SceneError {
             }
             SceneError::NonFiniteVertex {
                 path,
+                line,
                 triangle,
                 corner,
                 position,
-            } => write!(
-                f,
-                "{}: triangle {triangle} (0-based, load order), corner {corner}, has a NaN or \
-                 infinite coordinate ({}, {}, {})",
-                path.display(),
-                position[0],
-                position[1],
-                position[2]
-            ),
+            } => {
+                write!(f, "{}", path.display())?;
+                if let Some(line) = line {
+                    write!(f, " line {line}")?;
+                }
+                write!(
+                    f,
+                    ": vertex ({}, {}, {}) has a NaN or infinite coordinate (or one past single \
+                     precision's range, about 3.4e38); it is corner {corner} of triangle \
+                     {triangle} (0-based, load order)",
+                    position[0], position[1], position[2]
+                )
+            }
             SceneError::UnknownBuiltin { name } => write!(
                 f,
                 "unknown built-in scene 'builtin:{name}' (known: {})",

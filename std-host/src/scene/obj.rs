@@ -227,7 +227,7 @@ impl Scene {
                 path: label.to_path_buf(),
             });
         }
-        check_finite(&triangles, label)?;
+        check_finite(&triangles, &text, label)?;
 
         let emissive = material
             .iter()
@@ -258,14 +258,15 @@ fn utf8_text(bytes: Vec<u8>, label: &Path) -> Result<String, SceneError> {
     })
 }
 
-/// Rejects the first triangle with a NaN or infinite coordinate. Only vertices used by faces are
-/// checked: an unused bad vertex cannot reach a BVH.
-fn check_finite(triangles: &[Triangle], label: &Path) -> Result<(), SceneError> {
+/// Rejects the first triangle with a NaN or infinite coordinate, naming the line of its vertex
+/// in `text`. Only vertices used by faces are checked: an unused bad vertex cannot reach a BVH.
+fn check_finite(triangles: &[Triangle], text: &str, label: &Path) -> Result<(), SceneError> {
     for (triangle, t) in triangles.iter().enumerate() {
         for (corner, p) in [t.v0, t.v1, t.v2].into_iter().enumerate() {
             if !p.is_finite() {
                 return Err(SceneError::NonFiniteVertex {
                     path: label.to_path_buf(),
+                    line: position_line(text, p.to_array()),
                     triangle,
                     corner,
                     position: p.to_array(),
@@ -274,6 +275,21 @@ fn check_finite(triangles: &[Triangle], label: &Path) -> Result<(), SceneError> 
         }
     }
     Ok(())
+}
+
+/// The line (from 1) of the first `v` statement that reads as `position` (a NaN equal to any
+/// NaN): found only for an error, since the loader keeps no line per vertex.
+fn position_line(text: &str, position: [f32; 3]) -> Option<usize> {
+    let same = |a: f32, b: f32| a == b || (a.is_nan() && b.is_nan());
+    text.lines().enumerate().find_map(|(i, line)| {
+        let mut words = line.split_whitespace();
+        if words.next() != Some("v") {
+            return None;
+        }
+        let read: Vec<f32> = words.take(3).map_while(|w| w.parse().ok()).collect();
+        let found = read.len() == 3 && read.iter().zip(position).all(|(&a, b)| same(a, b));
+        found.then_some(i + 1)
+    })
 }
 
 /// What the line-level check found besides errors.
@@ -471,7 +487,16 @@ fn check_obj(text: &str, label: &Path) -> Result<ObjCheck, SceneError> {
                         })?;
                         let n = defined[k];
                         // `i` names the i-th element, `-i` the i-th from the last one defined.
-                        if index == 0 || index.unsigned_abs() > n as u64 {
+                        if index == 0 {
+                            return Err(malformed(
+                                number,
+                                format!(
+                                    "face vertex '{vertex}' has index 0: OBJ indices count from \
+                                     1 (or back from -1, the last one defined)"
+                                ),
+                            ));
+                        }
+                        if index.unsigned_abs() > n as u64 {
                             return Err(SceneError::MissingVertex {
                                 path: label.to_path_buf(),
                                 line: number,
@@ -603,17 +628,20 @@ mod tests {
     }
 
     #[test]
+    fn index_zero_is_malformed_not_missing() {
+        let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n").to_string();
+        assert!(e.contains("line 4: face vertex '0' has index 0"), "{e}");
+        let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/0 3/1\n").to_string();
+        assert!(e.contains("line 5: face vertex '2/0' has index 0"), "{e}");
+    }
+
+    #[test]
     fn out_of_range_indices_are_errors_not_panics() {
         for (text, kind, index) in [
             (
                 "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
                 VertexKind::Position,
                 4,
-            ),
-            (
-                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n",
-                VertexKind::Position,
-                0,
             ),
             (
                 "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n",
@@ -753,8 +781,9 @@ mod tests {
                 SceneError::NonFiniteVertex {
                     triangle,
                     corner: c,
+                    line,
                     ..
-                } => assert_eq!((triangle, c), (1, corner)),
+                } => assert_eq!((triangle, c, line), (1, corner, Some(4))),
                 e => panic!("unexpected {e}"),
             }
         }

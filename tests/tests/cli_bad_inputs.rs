@@ -444,7 +444,10 @@ fn experiment_errors_name_the_file_and_line() {
         fails(&bin, &["experiment", e, "--out", o], needle);
     }
     // A scene file that cannot be read is named with the configuration that wants it.
-    let text = format!("[settings]\nrays_per_config = 10\n{config}file = \"a.obj\"\n{config}file = \"absent.obj\"\n");
+    let text = format!(
+        "[settings]\nrays_per_config = 10\n{config}file = \"a.obj\"\n\
+         {config}file = \"absent.obj\"\n"
+    );
     std::fs::write(&file, text).unwrap();
     std::fs::write(dir.join("a.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     fails(

@@ -17,6 +17,14 @@ pub enum BuildError {
     },
     /// More primitives than `u32` indices can address.
     TooManyPrimitives,
+    /// A subset's id names no triangle of the slice
+    /// ([`crate::build::BuildArena::load_triangle_subset`]).
+    NoSuchPrimitive {
+        /// The id, or `None` when it is not a `u32` at all (negative, or too large).
+        index: Option<u32>,
+        /// How many triangles the slice holds.
+        count: usize,
+    },
     /// A configuration value is out of range.
     InvalidConfig(&'static str),
 }
@@ -31,6 +39,17 @@ impl fmt::Display for BuildError {
                 write!(f, "build arena is full (capacity {capacity} primitives)")
             }
             BuildError::TooManyPrimitives => f.write_str("more than 2^32 - 1 primitives"),
+            BuildError::NoSuchPrimitive { index, count } => {
+                match index {
+                    Some(i) => write!(f, "id {i} names no triangle")?,
+                    None => f.write_str("an id that is not a u32 names no triangle")?,
+                }
+                write!(
+                    f,
+                    " (the slice holds {count}, ids 0 to {})",
+                    count.saturating_sub(1)
+                )
+            }
             BuildError::InvalidConfig(why) => write!(f, "invalid build configuration: {why}"),
         }
     }

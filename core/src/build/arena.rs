@@ -508,11 +508,13 @@ impl BuildArena {
         if tris.len() > u32::MAX as usize {
             return Err(BuildError::TooManyPrimitives);
         }
+        let missing = |index| BuildError::NoSuchPrimitive {
+            index,
+            count: tris.len(),
+        };
         for id in ids {
-            let id: u32 = id.try_into().map_err(|_| BuildError::TooManyPrimitives)?;
-            let tri = tris
-                .get(id as usize)
-                .ok_or(BuildError::InvalidPrimitive { index: id })?;
+            let id: u32 = id.try_into().map_err(|_| missing(None))?;
+            let tri = tris.get(id as usize).ok_or(missing(Some(id)))?;
             // `Vec3::min`/`max` drop a NaN operand, so the bounds alone could hide one.
             if !tri.is_finite() {
                 return Err(BuildError::InvalidPrimitive { index: id });
@@ -696,8 +698,22 @@ mod tests {
         assert!(arena.is_empty());
         assert!(arena.load_triangle_subset(&bad, [0u32, 1]).is_err());
         assert!(arena.is_empty());
-        assert!(arena.load_triangle_subset(&bad, [0u32, 7]).is_err());
+        // An id past the slice, or one that is no u32, names no triangle (not a bad one).
+        let missing = |index| BuildError::NoSuchPrimitive { index, count: 3 };
+        assert_eq!(
+            arena.load_triangle_subset(&bad, [0u32, 7]),
+            Err(missing(Some(7)))
+        );
         assert!(arena.is_empty() && arena.bounds.is_empty());
+        assert_eq!(
+            arena.load_triangle_subset(&bad, [0i64, -1]),
+            Err(missing(None))
+        );
+        let shown = alloc::format!("{}", missing(Some(7)));
+        assert!(
+            shown.contains("id 7 names no triangle (the slice holds 3"),
+            "{shown}"
+        );
         arena.load_triangle_subset(&bad, [2u32, 0]).unwrap();
         assert_eq!(arena.len(), 2);
     }

@@ -29,7 +29,7 @@ const C_BLOCK: f32 = 1.0;
 
 /// Largest binary subtree the collapse may turn into one leaf (two blocks). A binary subtree of at
 /// most [`super::WideBvh::ONE_BLOCK`] triangles is always one leaf (so a build that does not split
-/// such nodes collapses to the same wide tree); one of five to eight becomes a leaf when that is
+/// such nodes collapses to the same wide nodes); one of five to eight becomes a leaf when that is
 /// cheaper than opening it.
 pub(crate) const LEAF_BLOCK: usize = 8;
 

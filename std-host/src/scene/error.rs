@@ -171,9 +171,9 @@ impl std::error::Error for SceneError {
     }
 }
 
-/// Something the loader tolerated. The scene's geometry is complete; only material information
-/// (and so the emissive flags) may be missing.
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// Something the loader tolerated. The scene's geometry is complete; material information (and
+/// so the emissive flags) may be missing, or its scale may keep rays from hitting it.
+#[derive(Clone, Debug, PartialEq)]
 pub enum SceneWarning {
     /// A `mtllib` file could not be read: its materials are missing, so the triangles that use
     /// them get no material and are not emissive.
@@ -201,6 +201,35 @@ pub enum SceneWarning {
         /// How many such elements were skipped.
         count: usize,
     },
+    /// The scene's coordinates reach past [`SceneWarning::FAR`] (or the whole scene is smaller
+    /// than [`SceneWarning::TINY`]): there the single-precision ray/triangle test overflows (or
+    /// underflows) and refuses hits, so rays would miss what they should hit (README, Known
+    /// limits). The scene loads; scaling or recentring it fixes it.
+    OutsidePrecisionRange {
+        /// The largest coordinate's magnitude.
+        largest: f32,
+        /// The scene box's longest side.
+        extent: f32,
+    },
+}
+
+impl SceneWarning {
+    /// Coordinates past this refuse hits: Moller-Trumbore's `t` numerator is about the cube of
+    /// the coordinates (relative to the ray), which overflows f32 near 1e12 and more.
+    pub const FAR: f32 = 1e12;
+    /// A scene smaller than this refuses hits: the same cube underflows below about 1e-12.
+    pub const TINY: f32 = 1e-11;
+
+    /// The warning for a scene with bounds `bounds`, if it needs one.
+    pub fn precision(bounds: &rdbvh_core::geometry::Aabb) -> Option<SceneWarning> {
+        if bounds.is_empty() {
+            return None;
+        }
+        let largest = bounds.min.abs().max(bounds.max.abs()).max_element();
+        let extent = (bounds.max - bounds.min).max_element();
+        (largest > Self::FAR || extent < Self::TINY)
+            .then_some(SceneWarning::OutsidePrecisionRange { largest, extent })
+    }
 }
 
 impl fmt::Display for SceneWarning {
@@ -224,6 +253,14 @@ impl fmt::Display for SceneWarning {
             SceneWarning::SkippedNonSurfaces { count } => write!(
                 f,
                 "skipped {count} point or line elements (not surfaces, so not triangles)"
+            ),
+            SceneWarning::OutsidePrecisionRange { largest, extent } => write!(
+                f,
+                "coordinates reach {largest:e} and the scene spans {extent:e}: single-precision \
+                 ray/triangle tests refuse hits past about {:e} units or on scenes smaller than \
+                 about {:e}, so rays may miss what they should hit; scale or recentre the scene",
+                Self::FAR,
+                Self::TINY
             ),
         }
     }

@@ -236,6 +236,7 @@ impl Scene {
         let bounds = triangles
             .iter()
             .fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
+        warnings.extend(SceneWarning::precision(&bounds));
         Ok(Scene {
             name: label.display().to_string(),
             triangles,
@@ -625,6 +626,24 @@ mod tests {
     fn relative_indices_resolve() {
         let s = Scene::from_obj_str("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n").unwrap();
         assert_eq!(s.triangles[0].v1, Vec3::X);
+    }
+
+    /// Found by black-box testing: a scene near 1e13 (or 1e-13) units loaded and built without
+    /// a word, and every ray missed it. It still loads, with a warning.
+    #[test]
+    fn scenes_past_single_precision_range_load_with_a_warning() {
+        let scaled = |s: f32| format!("v 0 0 {s}\nv {s} 0 {s}\nv 0 {s} {s}\nf 1 2 3\n");
+        for (s, warned) in [(1e13, true), (5e-13, true), (1e11, false), (1e-9, false)] {
+            let scene = Scene::from_obj_str(&scaled(s)).unwrap();
+            let found = scene
+                .warnings
+                .iter()
+                .any(|w| matches!(w, SceneWarning::OutsidePrecisionRange { .. }));
+            assert_eq!(found, warned, "{s}: {:?}", scene.warnings);
+        }
+        let far = Scene::from_obj_str(&scaled(1e13)).unwrap();
+        let shown = far.warnings[0].to_string();
+        assert!(shown.starts_with("coordinates reach 1e13"), "{shown}");
     }
 
     #[test]

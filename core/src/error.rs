@@ -44,11 +44,10 @@ impl fmt::Display for BuildError {
                     Some(i) => write!(f, "id {i} names no triangle")?,
                     None => f.write_str("an id that is not a u32 names no triangle")?,
                 }
-                write!(
-                    f,
-                    " (the slice holds {count}, ids 0 to {})",
-                    count.saturating_sub(1)
-                )
+                match count.checked_sub(1) {
+                    Some(last) => write!(f, " (the slice holds {count}, ids 0 to {last})"),
+                    None => f.write_str(" (the slice is empty)"),
+                }
             }
             BuildError::InvalidConfig(why) => write!(f, "invalid build configuration: {why}"),
         }

@@ -711,7 +711,16 @@ mod tests {
         );
         let shown = alloc::format!("{}", missing(Some(7)));
         assert!(
-            shown.contains("id 7 names no triangle (the slice holds 3"),
+            shown.contains("id 7 names no triangle (the slice holds 3, ids 0 to 2)"),
+            "{shown}"
+        );
+        let none = BuildError::NoSuchPrimitive {
+            index: Some(0),
+            count: 0,
+        };
+        let shown = alloc::format!("{none}");
+        assert!(
+            shown.ends_with("names no triangle (the slice is empty)"),
             "{shown}"
         );
         arena.load_triangle_subset(&bad, [2u32, 0]).unwrap();

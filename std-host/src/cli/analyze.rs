@@ -286,11 +286,8 @@ fn is_json(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("json"))
 }
 
-fn write_nodes(
-    path: &Path,
-    records: &[NodeRow<'_>],
-    columns: Option<&[String]>,
-) -> Result<(), CliError> {
+/// Writes the node export: every field as JSON for a `.json` path, else the CSV `columns`.
+fn write_nodes(path: &Path, records: &[NodeRow<'_>], columns: &[String]) -> Result<(), CliError> {
     let fail = |e: std::io::Error| CliError::Write {
         path: path.to_path_buf(),
         source: e,
@@ -309,11 +306,10 @@ fn write_nodes(
             .map_err(|e| fail(std::io::Error::other(e)))?;
         return std::fs::write(path, text).map_err(fail);
     }
-    let cols = node_columns(columns)?;
-    let mut text = cols.join(",");
+    let mut text = columns.join(",");
     text.push('\n');
     for r in records {
-        let row: Vec<String> = cols.iter().map(|c| node_field(r, c).csv()).collect();
+        let row: Vec<String> = columns.iter().map(|c| node_field(r, c).csv()).collect();
         text.push_str(&row.join(","));
         text.push('\n');
     }
@@ -351,7 +347,7 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
         ))
     })?;
     // Before any work, as clap's own checks are: a bad column must not wait for the analysis.
-    node_columns(args.columns.as_deref())?;
+    let columns = node_columns(args.columns.as_deref())?;
     if let Some(nodes) = &args.nodes {
         super::check_output(nodes, &[Path::new(&args.scene), args.areas.as_path()])?;
         if args.columns.is_some() && is_json(nodes) {
@@ -402,7 +398,7 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
                     .zip(&pah)
                     .map(|(sah, pah)| NodeRow { sah, pah })
                     .collect();
-                write_nodes(path, &rows, args.columns.as_deref())?;
+                write_nodes(path, &rows, &columns)?;
             }
         }
         reports.push(metrics_json(entry.index + 1, kind, &m, c.error()));

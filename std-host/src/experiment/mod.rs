@@ -42,7 +42,8 @@ mod toplevel_study;
 pub use error::ExperimentError;
 pub use plots::fonts_available;
 pub use results::{
-    header, read_table, read_thesis_results, thesis_result_files, RunRow, Table, THESIS_COLUMNS,
+    header, read_table, read_thesis_files, read_thesis_results, thesis_result_files, RunRow, Table,
+    THESIS_COLUMNS,
 };
 pub use run::{build_fallback, run_one, sample_rays, RunMetrics, RunSetup};
 pub use settings::{parse_presets, settings_of, ExperimentFile, Settings, MAX_CANDIDATE_PLANES};
@@ -246,7 +247,10 @@ pub fn run_experiment(
     // The thesis's results before any run: a folder that cannot be read fails in a moment, not
     // after the runs, and its files join the inputs that no output may be.
     let thesis_results = match &opts.thesis_results {
-        Some(dir) => Some((read_thesis_results(dir)?, thesis_result_files(dir)?)),
+        Some(dir) => {
+            let files = thesis_result_files(dir)?;
+            Some((read_thesis_files(&files)?, files))
+        }
         None => None,
     };
     // The output folder first: a path that cannot be one fails before the runs, not after.

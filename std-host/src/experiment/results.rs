@@ -268,9 +268,14 @@ fn read_table_checked(path: &Path, numeric: bool) -> Result<Table, ExperimentErr
 
 /// Reads the thesis's `Plane_*.csv` and `Point_*.csv` files in `dir` into one table.
 pub fn read_thesis_results(dir: &Path) -> Result<Table, ExperimentError> {
+    read_thesis_files(&thesis_result_files(dir)?)
+}
+
+/// Reads the thesis's result `files` (as [`thesis_result_files`] lists them) into one table.
+pub fn read_thesis_files(files: &[PathBuf]) -> Result<Table, ExperimentError> {
     let mut out = Table::new();
-    for f in thesis_result_files(dir)? {
-        out.extend(read_table_checked(&f, true)?);
+    for f in files {
+        out.extend(read_table_checked(f, true)?);
     }
     Ok(out)
 }

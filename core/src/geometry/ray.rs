@@ -54,13 +54,14 @@ pub struct Ray {
     /// End of the segment (may be `+inf`).
     pub t_max: f32,
     /// The ray's anchor: the point of its line nearest the world origin, when that lies ahead of
-    /// the origin (`t > 0`), else the origin itself. See [`Ray::anchor`].
+    /// the origin (`t > 0`) and nearer the world origin than the ray's origin, else the origin
+    /// itself. See [`Ray::anchor`].
     pub(crate) anchor: Vec3,
     /// The ray parameter of [`Ray::anchor`] (0 when the anchor is the origin).
     pub(crate) anchor_t: f32,
-    /// `dot(origin, dir) + anchor_t |dir|^2 / 2`: a point `p` is nearer the anchor than the
-    /// origin when `dot(p, dir)` exceeds it (see [`Ray::anchor_is_nearer`]; rounding matters only
-    /// where the two are about as near).
+    /// `dot(origin, dir) + (anchor_t |dir|^2 + |anchor| |dir|) / 2`: a triangle at `p` is
+    /// measured from the anchor when `dot(p, dir)` exceeds it (see [`Ray::measures_from_anchor`];
+    /// rounding matters only where the two points err about alike).
     pub(crate) anchor_split: f32,
     /// `|dir|^2` in f64, where no finite f32 direction's square overflows or underflows: the
     /// triangle tests' determinant check (`determinant_is_noise`) needs it for every hit. Kept
@@ -71,8 +72,8 @@ pub struct Ray {
 
 /// The anchor of the line `origin + t dir`: `(t_a, origin + t_a dir, split, |dir|^2)` with `t_a`
 /// the parameter of the point nearest the world origin, or `(0, origin, ..)` when that point is
-/// not ahead (`t_a <= 0`); `split` is [`Ray::anchor_split`], `|dir|^2` in f64
-/// [`Ray::dir_len_sq`].
+/// not ahead (`t_a <= 0`) or no nearer the world origin than the ray's origin; `split` is
+/// [`Ray::anchor_split`], `|dir|^2` in f64 [`Ray::dir_len_sq`].
 ///
 /// Computed in f64 and rounded once: `t_a` to f32 first, then the point at that very `t_a`, so the
 /// anchor lies on the ray to the rounding of its own coordinates (in f32 `origin + t_a dir` would
@@ -90,8 +91,20 @@ fn anchor_of(origin: Vec3, dir: Vec3) -> (f32, Vec3, f32, f64) {
         return (0.0, origin, od as f32, dd);
     }
     let at = |k: usize| (o[k] + d[k] * f64::from(t)) as f32;
-    let split = od + f64::from(t) * dd * 0.5;
-    (t, Vec3::new(at(0), at(1), at(2)), split as f32, dd)
+    let anchor = Vec3::new(at(0), at(1), at(2));
+    // Rounded to f32, the anchor lies off the line by up to half an ulp of its coordinates,
+    // about 2^-24 |a|, while the origin lies on it exactly: measured from the anchor, a test
+    // errs by about 2^-24 (|a| + |p - a|) for a triangle at `p`, from the origin by about
+    // 2^-24 |p - o|. Along the line the anchor wins past `t_a / 2 + |a| / (2 |d|)`, and never
+    // when the anchor is as far from the world origin as from the ray's origin (a ray started
+    // near a far scene, crossing it sideways): then the ray has no anchor.
+    let a = anchor.to_array().map(f64::from);
+    let (anchor_len, dir_len) = (libm::sqrt(dot(a, a)), libm::sqrt(dd));
+    if anchor_len >= f64::from(t) * dir_len {
+        return (0.0, origin, od as f32, dd);
+    }
+    let split = od + (f64::from(t) * dd + anchor_len * dir_len) * 0.5;
+    (t, anchor, split as f32, dd)
 }
 
 impl Ray {
@@ -136,26 +149,31 @@ impl Ray {
         }
     }
 
-    /// True when `p` is nearer the ray's anchor than its origin: `|p - a|^2 < |p - o|^2` with
-    /// `a = o + t_a d` is `dot(p - o, d) > t_a |d|^2 / 2`, so one dot product against a split
-    /// fixed per ray decides it. The triangle tests measure from the nearer of the two.
+    /// True when a triangle at `p` is better measured from the ray's anchor than from its
+    /// origin: when `|p - a| + |a| < |p - o|` along the line (the anchor's own rounding, about
+    /// 2^-24 `|a|`, counts against it), which for `a = o + t_a d` is
+    /// `dot(p - o, d) > (t_a |d|^2 + |a| |d|) / 2`: one dot product against a split fixed per
+    /// ray.
     #[inline(always)]
-    pub(crate) fn anchor_is_nearer(&self, p: Vec3) -> bool {
+    pub(crate) fn measures_from_anchor(&self, p: Vec3) -> bool {
         p.dot(self.dir) > self.anchor_split
     }
 
     /// The ray's second point to measure triangles from, and its ray parameter: the point of
-    /// its line nearest the world origin when that lies ahead of the origin, else the origin
-    /// and 0.
+    /// its line nearest the world origin when that lies ahead of the origin and nearer the world
+    /// origin than the ray's origin, else the origin and 0.
     ///
     /// Moller-Trumbore's edge decisions carry an f32 error proportional to the distance between
     /// the point it measures from and the triangle. Measured from the origin, a ray from 1e8
     /// units away decides within 8 units of a 12-unit triangle's edges: noise. The anchor is
     /// never farther from the world origin than any point of the ray ahead of it, hits included,
     /// so measured from it the error is that of the scene's own coordinates, wherever the ray
-    /// starts. A ray started near a triangle is better measured from its origin, so each
-    /// triangle test measures from whichever of the two is nearer the triangle's first vertex,
-    /// and a hit's `t` is that point's plus the test's own. Both depend on the origin and the
+    /// starts. But the anchor, rounded to f32, lies off the line by up to half an ulp of its own
+    /// coordinates, while the origin lies on it exactly: a ray started near a triangle is better
+    /// measured from its origin. Each triangle test measures from the point whose error at the
+    /// triangle's first vertex is the smaller (`Ray::measures_from_anchor`), and a hit's `t`
+    /// is that point's plus the test's own. A ray whose anchor is as far from the world origin
+    /// as from the ray's origin (started near a far scene and crossing it sideways) has none. Both depend on the origin and the
     /// direction alone, so every structure and the brute-force oracle, given the same ray (or a
     /// segment of it), decide alike.
     #[inline]

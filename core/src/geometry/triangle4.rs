@@ -46,7 +46,8 @@ pub struct Hits4 {
 /// determinant check, prepared once per ray.
 #[derive(Clone, Copy, Debug)]
 pub struct RayTri4 {
-    /// The ray's origin and anchor ([`Ray::anchor`]): the test measures from the nearer.
+    /// The ray's origin and anchor ([`Ray::anchor`]): the test measures from the one that errs
+    /// less (`Ray::measures_from_anchor`).
     origin: [f32x4; 3],
     anchor: [f32x4; 3],
     anchor_t: f32x4,
@@ -133,7 +134,7 @@ impl Triangle4 {
         let p = cross(ray.dir, e2);
         let det = dot(e1, p);
         let inv_det = f32x4::ONE / det;
-        // `Ray::anchor_is_nearer`, lane by lane.
+        // `Ray::measures_from_anchor`, lane by lane.
         let anchored = dot(v0, ray.dir).simd_gt(ray.anchor_split);
         let s: [f32x4; 3] =
             core::array::from_fn(|k| anchored.select(ray.anchor[k], ray.origin[k]) - v0[k]);

@@ -443,6 +443,25 @@ mod tests {
         // A box behind the eye is never hit.
         let behind = Aabb::new(Vec3::new(-1.0, -1.0, -3.0), Vec3::new(1.0, 1.0, -2.0));
         assert_eq!(sa.measure(&behind), 0.0);
+        // Nearly flat windows (found by black-box testing: a box around the eye of a 179.99 by
+        // 1 degree light measured 180 windows, so a one-leaf tree's PAH cost read 540 for 3
+        // triangles), and the boxes of the scene that showed it.
+        for (fx, fy, near) in [
+            (179.99, 1.0, 0.0),
+            (1.0, 179.999, 0.0),
+            (179.9, 179.9, 0.01),
+        ] {
+            let a = PointArea::new(Vec3::ZERO, Vec3::X, fx, fy, near, 100.0).unwrap();
+            let sa = PahPerspective::for_area(&a, PerspectiveMeasure::SolidAngle);
+            let w = sa.window_measure();
+            // Holding the eye and the near plane's window (11.5 units wide at 179.9 degrees).
+            let root = Aabb::new(Vec3::new(-1.0, -20.0, -20.0), Vec3::new(3.0, 20.0, 20.0));
+            let m = sa.measure(&root);
+            assert!((m - w).abs() <= 1e-5 * w, "{fx} x {fy}: {m} against {w}");
+            let wall = Aabb::new(Vec3::new(3.0, -1.0, -1.0), Vec3::new(3.0, 1.0, 1.0));
+            let part = sa.measure(&wall);
+            assert!(part > 0.0 && part < w, "{fx} x {fy}: {part} against {w}");
+        }
     }
 
     #[test]

@@ -8,7 +8,7 @@
 //!
 //! `RDBVH_PROFILE_PAH=1` adds the `full` (PAH + SPFH) and `pah` (PAH over all axes) presets over
 //! the `peers` table's plane and point areas: CPU time, its ratio to the SAH build's, and the
-//! tree's hash; `plane` or `point` instead of `1` builds over that area alone, and
+//! tree's PAH cost (`C_trav = C_isect = 1`) and hash; `plane` or `point` instead of `1` builds over that area alone, and
 //! `RDBVH_PROFILE_PRESET=full` (or `pah`) that preset alone (for
 //! `--toggle-collect=build_profile::pah_once`).
 //! With AREAS.toml (an area file, as `rdbvh build --areas` takes), PRESET (default `full`) is
@@ -26,7 +26,7 @@ use std::time::Instant;
 
 use rdbvh_benches::compare::{plane_area_over, point_area_over};
 use rdbvh_benches::{load_scene, thread_cpu_seconds};
-use rdbvh_core::build::{BuildArena, Builder, Preset, PresetError, PresetOptions};
+use rdbvh_core::build::{AreaPah, BuildArena, Builder, Preset, PresetError, PresetOptions};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::heuristics::{CostConstants, Sah};
@@ -184,8 +184,12 @@ fn main() -> ExitCode {
                 pah_once(&tris, preset, area, &mut arena, &mut out).expect("pah build");
                 best_pah = best_pah.min(thread_cpu_seconds() - t);
             }
+            let pah = AreaPah::new(area, PresetOptions::default().perspective);
+            let pah_cost =
+                out.estimated_cost_over(&pah, CostConstants::default(), pah.window_measure());
             println!(
-                "  {preset} {name} area: {:.2} ms ({:.2}x the SAH build); tree {:016x}",
+                "  {preset} {name} area: {:.2} ms ({:.2}x the SAH build); pah_cost {pah_cost:.4}; \
+                 tree {:016x}",
                 best_pah * 1e3,
                 best_pah / best,
                 tree_hash(&out)

@@ -87,17 +87,27 @@ impl ConvexPolygon {
         &self.points[..self.len]
     }
 
-    /// Shoelace area (zero for fewer than three vertices).
+    /// Shoelace area (zero for fewer than three vertices), as a fan from the first vertex in
+    /// f64, where differences of f32 coordinates are exact: about the origin in f32, a unit
+    /// square 1e4 away summed terms of 1e8 and kept none of its own area's bits.
     pub fn area(&self) -> f32 {
         let p = self.points();
         if p.len() < 3 {
             return 0.0;
         }
-        let mut twice = 0.0;
-        for i in 0..p.len() {
-            twice += p[i].perp_dot(p[(i + 1) % p.len()]);
+        let o = p[0];
+        let from_o = |v: Vec2| {
+            (
+                f64::from(v.x) - f64::from(o.x),
+                f64::from(v.y) - f64::from(o.y),
+            )
+        };
+        let mut twice = 0.0f64;
+        for w in p[1..].windows(2) {
+            let ((ax, ay), (bx, by)) = (from_o(w[0]), from_o(w[1]));
+            twice += ax * by - ay * bx;
         }
-        0.5 * twice.abs()
+        (0.5 * twice.abs()) as f32
     }
 
     /// The axis-aligned bounds `(min, max)` of the vertices.
@@ -204,6 +214,20 @@ mod tests {
         let h = ConvexPolygon::hull(&pts);
         assert_eq!(h.points().len(), 4);
         assert!((h.area() - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn area_far_from_the_origin() {
+        for offset in [0.0f32, 1e4, -3e5, 1e7] {
+            let (x, y) = (offset, -offset / 2.0);
+            let h = ConvexPolygon::hull(&[
+                Vec2::new(x, y),
+                Vec2::new(x + 1.0, y),
+                Vec2::new(x + 1.0, y + 0.5),
+                Vec2::new(x, y + 0.5),
+            ]);
+            assert_eq!(h.area(), 0.5, "at {offset}");
+        }
     }
 
     #[test]

@@ -266,19 +266,18 @@ mod tests {
     fn solid_angle_of_wide_and_far_rectangles() {
         let f = |x: f64, y: f64| libm::atan(x * y / libm::sqrt(1.0 + x * x + y * y));
         let tan = |deg: f64| libm::tan(deg.to_radians() / 2.0);
-        let mut cases = [(0.0f32, 0.0f32, 0.0f32, 0.0f32); 0].to_vec();
-        for (fx, fy) in [
+        let windows = [
             (179.999, 1.0),
             (179.99, 0.001),
             (179.98, 179.98),
             (90.0, 179.9),
-        ] {
+        ]
+        .map(|(fx, fy)| {
             let (tx, ty) = (tan(fx) as f32, tan(fy) as f32);
-            cases.push((-tx, tx, -ty, ty));
-        }
-        cases.push((1000.0, 1001.0, 2000.0, 2000.5));
-        cases.push((-3000.0, 2.0, 0.5, 0.75));
-        for (x1, x2, y1, y2) in cases {
+            (-tx, tx, -ty, ty)
+        });
+        let far = [(1000.0, 1001.0, 2000.0, 2000.5), (-3000.0, 2.0, 0.5, 0.75)];
+        for (x1, x2, y1, y2) in windows.into_iter().chain(far) {
             let h = ConvexPolygon::hull(&[
                 Vec2::new(x1, y1),
                 Vec2::new(x2, y1),

@@ -173,9 +173,9 @@ impl Ray {
     /// measured from its origin. Each triangle test measures from the point whose error at the
     /// triangle's first vertex is the smaller (`Ray::measures_from_anchor`), and a hit's `t`
     /// is that point's plus the test's own. A ray whose anchor is as far from the world origin
-    /// as from the ray's origin (started near a far scene and crossing it sideways) has none. Both depend on the origin and the
-    /// direction alone, so every structure and the brute-force oracle, given the same ray (or a
-    /// segment of it), decide alike.
+    /// as from the ray's origin (started near a far scene and crossing it sideways) has none.
+    /// Both depend on the origin and the direction alone, so every structure and the
+    /// brute-force oracle, given the same ray (or a segment of it), decide alike.
     #[inline]
     pub fn anchor(&self) -> (f32, Vec3) {
         (self.anchor_t, self.anchor)

@@ -462,6 +462,28 @@ mod tests {
             let part = sa.measure(&wall);
             assert!(part > 0.0 && part < w, "{fx} x {fy}: {part} against {w}");
         }
+        // Nearly closed windows (found by black-box testing: a light of 1e-8 degrees aimed at
+        // the teapot measured its box as 8% of the window, a one-leaf tree's cost 0.15 for 2
+        // triangles): a box across the axis covers the whole window, one beside it none.
+        for fov in [1e-6, 1e-8, 1e-13] {
+            let eye = Vec3::new(3.0, 1.0, -30.0);
+            let a = PointArea::new(eye, Vec3::new(0.01, 0.02, 1.0), fov, fov, 0.0, 60.0).unwrap();
+            for m in [
+                PerspectiveMeasure::SolidAngle,
+                PerspectiveMeasure::ImagePlane,
+            ] {
+                let pah = PahPerspective::for_area(&a, m);
+                let w = pah.window_measure();
+                let across = Aabb::new(Vec3::new(-17.0, -9.0, -3.0), Vec3::new(17.0, 9.0, 3.0));
+                let m_across = pah.measure(&across);
+                assert!(
+                    (m_across - w).abs() <= 1e-6 * w,
+                    "{fov} {m:?}: {m_across} against {w}"
+                );
+                let beside = Aabb::new(Vec3::new(5.0, -9.0, -3.0), Vec3::new(17.0, 9.0, 3.0));
+                assert_eq!(pah.measure(&beside), 0.0, "{fov} {m:?}");
+            }
+        }
     }
 
     #[test]

@@ -47,6 +47,8 @@ pub enum OverlapSpace {
         frame: Frame,
         /// Near-plane distance.
         near: f32,
+        /// Far-plane distance: with culling, boxes are cut there too (rays stop there).
+        far: f32,
         /// Half fields of view as tangents, when culling.
         window: Option<Vec2>,
     },
@@ -72,6 +74,7 @@ impl OverlapSpace {
                     eye: f.eye,
                     frame: f.frame,
                     near: f.near,
+                    far: f.far,
                     window: culled.then_some(Vec2::new(f.tan_x, f.tan_y)),
                 }
             }
@@ -113,10 +116,11 @@ impl OverlapSpace {
                 eye,
                 frame,
                 near,
+                far,
                 window,
             } => {
                 let project = |x: &Aabb| match window {
-                    Some(t) => windowed_silhouette(x, eye, &frame, near, t),
+                    Some(t) => windowed_silhouette(x, eye, &frame, (near, far), t),
                     None => perspective_silhouette(x, eye, &frame, near),
                 };
                 let (pa, pb) = (project(a), project(b));

@@ -77,24 +77,32 @@ pub fn perspective_silhouette(b: &Aabb, eye: Vec3, frame: &Frame, near: f32) -> 
     ConvexPolygon::hull(&pts[..n])
 }
 
-/// The perspective silhouette of the part of `b` at least `near >= 0` in front of the eye,
-/// clipped to the light's window `[-tan, tan]` on the image plane `z = 1`. Projecting first and
-/// clipping the hull is exact to rounding while the projected points stay within
-/// [`PRECISE_SPAN`] windows of the axis (as they do unless the box comes close to the eye's plane
-/// beside the eye); otherwise the box is clipped in 3D first ([`perspective_window_silhouette`],
-/// several times the work, so only then).
+/// The perspective silhouette of the part of `b` at depths `depth = (near, far)` in front of the
+/// eye (`0 <= near`: where the rays start and stop), clipped to the light's window `[-tan, tan]`
+/// on the image plane `z = 1`. Projecting first and clipping the hull is exact to rounding while
+/// the box lies before the far plane and the projected points stay within [`PRECISE_SPAN`]
+/// windows of the axis (as they do unless the box comes close to the eye's plane beside the
+/// eye); otherwise the box is clipped in 3D first ([`perspective_window_silhouette`], several
+/// times the work, so only then).
 pub fn windowed_silhouette(
     b: &Aabb,
     eye: Vec3,
     frame: &Frame,
-    near: f32,
+    depth: (f32, f32),
     tan: Vec2,
 ) -> ConvexPolygon {
+    let (near, far) = depth;
     // A box that every ray meets (the root's box, with the light inside or a narrow light
     // pointing at it) covers the whole window.
     let window = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
-    if covers_window(b, eye, frame, near, tan) {
+    if covers_window(b, eye, frame, depth, tan) {
         return ConvexPolygon::hull(&window.map(|(x, y)| Vec2::new(x * tan.x, y * tan.y)));
+    }
+    // Rays stop at the far plane: a box reaching past it is cut there, in 3D.
+    let (c, h) = (b.center() - eye, b.extent() * 0.5);
+    let deepest = c.dot(frame.forward) + h.dot(frame.forward.abs());
+    if deepest > far {
+        return perspective_window_silhouette(b, eye, frame, depth, tan);
     }
     let hull = perspective_silhouette(b, eye, frame, near);
     let span = PRECISE_SPAN * tan.max_element();
@@ -102,19 +110,19 @@ pub fn windowed_silhouette(
     let hull = if precise {
         hull
     } else {
-        perspective_window_silhouette(b, eye, frame, near, tan)
+        perspective_window_silhouette(b, eye, frame, depth, tan)
     };
     hull.clip_to_rect(-tan, tan)
 }
 
-/// True when the rays from the eye through the window's four corners all meet `b` at depth
-/// `near` or beyond: the part of a box beyond the near plane is convex, so its silhouette is,
-/// and holding the corners it holds the whole window. Slab tests in 3D and in f64, where the
+/// True when the rays from the eye through the window's four corners all meet `b` at a depth
+/// between `near` and `far`: the part of a box between the two planes is convex, so its
+/// silhouette is, and holding the corners it holds the whole window. Slab tests in 3D and in f64, where the
 /// corner directions keep the window's width beside `forward` (1e-10 of it for a light of 1e-8
 /// degrees). Clipping the projected hull to such a window cannot decide this: found by
 /// black-box testing, the teapot seen through a 1e-8 degree window measured 8% of it, since the
 /// hull's f32 vertices, about one window-width of the scene out, place its edges to 6e-8.
-fn covers_window(b: &Aabb, eye: Vec3, frame: &Frame, near: f32, tan: Vec2) -> bool {
+fn covers_window(b: &Aabb, eye: Vec3, frame: &Frame, depth: (f32, f32), tan: Vec2) -> bool {
     let wide = |v: Vec3| [v.x, v.y, v.z].map(f64::from);
     let (right, up, forward, eye) = (
         wide(frame.right),
@@ -128,7 +136,7 @@ fn covers_window(b: &Aabb, eye: Vec3, frame: &Frame, near: f32, tan: Vec2) -> bo
         .into_iter()
         .all(|(x, y)| {
             // The corner ray `eye + t d` is at depth `t`: `d . forward = 1`.
-            let (mut enter, mut leave) = (f64::from(near), f64::INFINITY);
+            let (mut enter, mut leave) = (f64::from(depth.0), f64::from(depth.1));
             for k in 0..3 {
                 let d = forward[k] + x * right[k] + y * up[k];
                 if d == 0.0 {
@@ -151,28 +159,30 @@ fn covers_window(b: &Aabb, eye: Vec3, frame: &Frame, near: f32, tan: Vec2) -> bo
 /// reach the eye's plane beside the eye), and the 3D clip costs several hull clips.
 pub const PRECISE_SPAN: f32 = 4096.0;
 
-/// The perspective silhouette of the part of `b` at least `near >= 0` in front of the eye and
-/// inside the pyramid of half-angle tangents `tan` (the light's window), on the image plane
-/// `z = 1`: the box is clipped in 3D before anything is projected. Each of its six faces is
-/// clipped (Sutherland-Hodgman) by the near plane and the pyramid's four side planes; the
-/// clipped faces' vertices are the clipped solid's, and all of them project into the window, so
-/// no projected point is large whatever `near` is (0 included). Projecting first and clipping
+/// The perspective silhouette of the part of `b` at depths `depth = (near, far)` in front of the
+/// eye (`0 <= near`) and inside the pyramid of half-angle tangents `tan` (the light's window), on
+/// the image plane `z = 1`: the box is clipped in 3D before anything is projected. Each of its six
+/// faces is clipped (Sutherland-Hodgman) by the near and far planes and the pyramid's four side
+/// planes; the clipped faces' vertices are the clipped solid's, and all of them project into the
+/// window, so no projected point is large whatever `near` is (0 included). Projecting first and clipping
 /// the hull to the window instead loses the window's precision to the long edges of points
 /// near the eye plane (a few 1e-4 of the measure with `near` 0).
 pub fn perspective_window_silhouette(
     b: &Aabb,
     eye: Vec3,
     frame: &Frame,
-    near: f32,
+    depth: (f32, f32),
     tan: Vec2,
 ) -> ConvexPolygon {
+    let (near, far) = depth;
     let local: [Vec3; 8] = core::array::from_fn(|i| frame.to_local(box_corner(b, i) - eye));
-    // Signed distance to plane `k` of the five, positive inside.
+    // Signed distance to plane `k` of the six, positive inside.
     let plane = |k: usize, p: Vec3| match k {
         0 => p.z - near,
-        1 => tan.x * p.z - p.x,
-        2 => tan.x * p.z + p.x,
-        3 => tan.y * p.z - p.y,
+        1 => far - p.z,
+        2 => tan.x * p.z - p.x,
+        3 => tan.x * p.z + p.x,
+        4 => tan.y * p.z - p.y,
         _ => tan.y * p.z + p.y,
     };
     // Points gathered for the hull; when they would overflow the hull's input, the hull of those
@@ -190,7 +200,7 @@ pub fn perspective_window_silhouette(
                 face[k] = local[side | bits];
             }
             let mut len = 4;
-            for k in 0..5 {
+            for k in 0..6 {
                 let mut clipped = [Vec3::ZERO; FACE_CLIP_MAX];
                 len = clip_convex(&face[..len], &mut clipped, |p| plane(k, p));
                 face = clipped;
@@ -231,4 +241,4 @@ pub fn perspective_window_silhouette(
 
 /// The most vertices a box face has while [`perspective_window_silhouette`] clips it: four,
 /// plus one per clipping plane.
-const FACE_CLIP_MAX: usize = 4 + 5;
+const FACE_CLIP_MAX: usize = 4 + 6;

@@ -22,8 +22,8 @@ pub use obb::Obb;
 pub(crate) use polygon::clip_convex;
 pub use polygon::{ConvexPolygon, MAX_POLY};
 pub use projection::{
-    box_corner, orthographic_silhouette, perspective_silhouette, perspective_window_silhouette,
-    windowed_silhouette, MIN_RELATIVE_DEPTH, PRECISE_SPAN,
+    box_corner, orthographic_silhouette, orthographic_slab_silhouette, perspective_silhouette,
+    perspective_window_silhouette, windowed_silhouette, MIN_RELATIVE_DEPTH, PRECISE_SPAN,
 };
 pub use ray::{Ray, RayError};
 #[cfg(test)]

@@ -185,22 +185,63 @@ pub fn perspective_window_silhouette(
         4 => tan.y * p.z - p.y,
         _ => tan.y * p.z + p.y,
     };
-    // Points gathered for the hull; when they would overflow the hull's input, the hull of those
-    // so far (a subset of them) takes their place. Two points closer than a millionth of the
-    // window (every point lies inside it) are one vertex reached from two faces.
-    let same = 1e-6 * tan.max_element();
-    let mut pts = [Vec2::ZERO; MAX_POLY];
-    let mut n = 0;
+    // Every point lies inside the window: two closer than a millionth of it are one vertex.
+    let mut hull = HullPoints::new(1e-6 * tan.max_element());
+    clipped_box_vertices(&local, 6, plane, |p| {
+        // The apex itself (near 0) projects nowhere, and the rest of the clipped solid already
+        // spans every direction it holds.
+        if p.z > 0.0 {
+            hull.push(Vec2::new(p.x / p.z, p.y / p.z));
+        }
+    });
+    hull.hull()
+}
+
+/// The orthographic silhouette, in `(right, up)` coordinates, of the part of `b` between the
+/// planes `forward . p = 0` and `forward . p = depth` (a plane area's rays start on the first and
+/// stop at the second, with `b` taken relative to the light's centre): the box's faces clipped to
+/// the slab, projected, and their hull. For boxes inside the slab it is
+/// [`orthographic_silhouette`]; for a box straddling either plane along an oblique `forward`,
+/// the projection of the whole box is larger.
+pub fn orthographic_slab_silhouette(b: &Aabb, frame: &Frame, depth: f32) -> ConvexPolygon {
+    let corners: [Vec3; 8] = core::array::from_fn(|i| box_corner(b, i));
+    let plane = |k: usize, p: Vec3| {
+        let z = p.dot(frame.forward);
+        if k == 0 {
+            z
+        } else {
+            depth - z
+        }
+    };
+    // Exact duplicates only: the points are not confined to a window that would bound the
+    // error of merging near ones.
+    let mut hull = HullPoints::new(0.0);
+    clipped_box_vertices(&corners, 2, plane, |p| {
+        hull.push(Vec2::new(p.dot(frame.right), p.dot(frame.up)));
+    });
+    hull.hull()
+}
+
+/// Calls `emit` with every vertex of each face of the box with corners `corners` (in
+/// [`box_corner`]'s order) clipped (Sutherland-Hodgman) to the half-spaces `plane(k, p) >= 0`,
+/// `k < planes`: the clipped faces' vertices are the clipped solid's, each found once per face
+/// it lies on.
+fn clipped_box_vertices(
+    corners: &[Vec3; 8],
+    planes: usize,
+    plane: impl Fn(usize, Vec3) -> f32,
+    mut emit: impl FnMut(Vec3),
+) {
     for (axis, other) in [(1usize, [2usize, 4]), (2, [4, 1]), (4, [1, 2])] {
         for side in [0, axis] {
             // The face's corners in cyclic order.
             let [u, v] = other;
             let mut face = [Vec3::ZERO; FACE_CLIP_MAX];
             for (k, bits) in [0, u, u | v, v].into_iter().enumerate() {
-                face[k] = local[side | bits];
+                face[k] = corners[side | bits];
             }
             let mut len = 4;
-            for k in 0..6 {
+            for k in 0..planes {
                 let mut clipped = [Vec3::ZERO; FACE_CLIP_MAX];
                 len = clip_convex(&face[..len], &mut clipped, |p| plane(k, p));
                 face = clipped;
@@ -208,37 +249,54 @@ pub fn perspective_window_silhouette(
                     break;
                 }
             }
-            for p in &face[..len] {
-                if p.z <= 0.0 {
-                    // The apex itself (near 0): it projects nowhere, and the rest of the
-                    // clipped solid already spans every direction it holds.
-                    continue;
-                }
-                let q = Vec2::new(p.x / p.z, p.y / p.z);
-                // A vertex of the solid is on three faces: keep it once.
-                if pts[..n]
-                    .iter()
-                    .any(|&r| (q - r).abs().max_element() <= same)
-                {
-                    continue;
-                }
-                if n == MAX_POLY {
-                    let hull = ConvexPolygon::hull(&pts);
-                    n = hull.points().len();
-                    pts[..n].copy_from_slice(hull.points());
-                }
-                // The solid's silhouette has at most one vertex per face of it (eleven), so a
-                // hull of distinct points always leaves room.
-                if n < MAX_POLY {
-                    pts[n] = q;
-                    n += 1;
-                }
-            }
+            face[..len].iter().copied().for_each(&mut emit);
         }
     }
-    ConvexPolygon::hull(&pts[..n])
 }
 
-/// The most vertices a box face has while [`perspective_window_silhouette`] clips it: four,
-/// plus one per clipping plane.
+/// Points gathered for a hull, without allocation: a point within `same` of one already held
+/// (a vertex of a solid reached from another of its faces) is dropped, and when the points would
+/// overflow the hull's input, the hull of those so far (a subset of them) takes their place.
+struct HullPoints {
+    pts: [Vec2; MAX_POLY],
+    n: usize,
+    same: f32,
+}
+
+impl HullPoints {
+    fn new(same: f32) -> Self {
+        Self {
+            pts: [Vec2::ZERO; MAX_POLY],
+            n: 0,
+            same,
+        }
+    }
+
+    fn push(&mut self, q: Vec2) {
+        if self.pts[..self.n]
+            .iter()
+            .any(|&r| (q - r).abs().max_element() <= self.same)
+        {
+            return;
+        }
+        if self.n == MAX_POLY {
+            let hull = ConvexPolygon::hull(&self.pts);
+            self.n = hull.points().len();
+            self.pts[..self.n].copy_from_slice(hull.points());
+        }
+        // A clipped box's silhouette has at most one vertex per face of the solid (eleven), so
+        // a hull of distinct points always leaves room.
+        if self.n < MAX_POLY {
+            self.pts[self.n] = q;
+            self.n += 1;
+        }
+    }
+
+    fn hull(&self) -> ConvexPolygon {
+        ConvexPolygon::hull(&self.pts[..self.n])
+    }
+}
+
+/// The most vertices a box face has while it is clipped ([`clipped_box_vertices`]): four, plus
+/// one per clipping plane (six at most).
 const FACE_CLIP_MAX: usize = 4 + 6;

@@ -4,7 +4,8 @@ use alloc::vec::Vec;
 
 use glam::Vec3;
 
-use crate::geometry::{Ray, Triangle};
+use crate::geometry::{Aabb, Ray, Triangle};
+use crate::influence::{InfluenceArea, RaySampler};
 use crate::random::Pcg32;
 
 /// `n` triangles: the first vertex uniform in `[lo, hi)^3`, the other two within `spread` of it
@@ -41,4 +42,18 @@ pub(crate) fn exact_intersection(tri: &Triangle, r: &Ray) -> (f64, f64, f64) {
     let s = sub(f(r.origin), v0);
     let q = cross(s, e1);
     (dot(e2, q) / det, dot(s, p) / det, dot(d, q) / det)
+}
+
+/// The fraction of `n` rays from `rays` that meet `b` before they leave `area`, theirs: a
+/// sampled hit probability for checking a PAH measure (the measure over the window's is its
+/// exact value).
+pub(crate) fn hit_fraction(rays: &mut RaySampler, area: &InfluenceArea, b: &Aabb, n: u32) -> f32 {
+    let hits = (0..n)
+        .filter(|_| {
+            let r = rays.sample();
+            area.exit(&r)
+                .is_some_and(|exit| b.intersect(&r, exit).is_some())
+        })
+        .count();
+    hits as f32 / n as f32
 }

@@ -341,7 +341,8 @@ mod tests {
     /// them, as sampled rays find it; a box behind the light or past its depth, nothing.
     #[test]
     fn boxes_are_cut_to_the_slab_the_rays_cross() {
-        use crate::influence::RaySampler;
+        use crate::influence::{InfluenceArea, RaySampler};
+        use crate::test_scenes::hit_fraction;
         let area = PlaneArea::new(
             Vec3::new(-1.0, 2.0, 0.5),
             Vec3::new(1.0, -0.7, 0.4),
@@ -367,17 +368,11 @@ mod tests {
                 area.center + f * 4.0 + Vec3::ONE,
             ),
         ];
+        let influence = InfluenceArea::from(area);
         for b in boxes {
-            let mut rays = RaySampler::new(area.into(), 4);
-            let n = 200_000;
-            let hits = (0..n)
-                .filter(|_| {
-                    let r = rays.sample();
-                    area.exit(&r)
-                        .is_some_and(|exit| b.intersect(&r, exit).is_some())
-                })
-                .count();
-            let sampled = pah.window_measure().unwrap() * hits as f32 / n as f32;
+            let mut rays = RaySampler::new(influence, 4);
+            let fraction = hit_fraction(&mut rays, &influence, &b, 200_000);
+            let sampled = pah.window_measure().unwrap() * fraction;
             let m = pah.measure(&b);
             assert!(
                 (m - sampled).abs() <= 0.02 * sampled,

@@ -496,6 +496,8 @@ mod tests {
     /// measures as its part before it, and a box wholly past it as nothing.
     #[test]
     fn boxes_are_cut_at_the_far_plane() {
+        use crate::influence::InfluenceArea;
+        use crate::test_scenes::hit_fraction;
         let a = PointArea::new(
             Vec3::ZERO,
             Vec3::new(0.1, -0.05, 1.0),
@@ -518,19 +520,13 @@ mod tests {
                 let m_whole = pah.measure(&whole);
                 // The same box cut by the far plane, sampled: the fraction of window directions
                 // whose ray meets the box before depth 10, times the window's measure.
-                let mut rays = RaySampler::new(a.into(), 9).distribution(match m {
+                let influence = InfluenceArea::from(a);
+                let mut rays = RaySampler::new(influence, 9).distribution(match m {
                     PerspectiveMeasure::SolidAngle => PointDistribution::SolidAngle,
                     PerspectiveMeasure::ImagePlane => PointDistribution::ImagePlane,
                 });
-                let n = 200_000;
-                let hits = (0..n)
-                    .filter(|_| {
-                        let r = rays.sample();
-                        a.exit(&r)
-                            .is_some_and(|exit| whole.intersect(&r, exit).is_some())
-                    })
-                    .count();
-                let sampled = pah.window_measure() * hits as f32 / n as f32;
+                let fraction = hit_fraction(&mut rays, &influence, &whole, 200_000);
+                let sampled = pah.window_measure() * fraction;
                 assert!(
                     (m_whole - sampled).abs() <= 0.02 * sampled,
                     "{m:?} {whole:?}: {m_whole} against {sampled} sampled"

@@ -117,11 +117,12 @@ pub fn windowed_silhouette(
 
 /// True when the rays from the eye through the window's four corners all meet `b` at a depth
 /// between `near` and `far`: the part of a box between the two planes is convex, so its
-/// silhouette is, and holding the corners it holds the whole window. Slab tests in 3D and in f64, where the
-/// corner directions keep the window's width beside `forward` (1e-10 of it for a light of 1e-8
-/// degrees). Clipping the projected hull to such a window cannot decide this: found by
-/// black-box testing, the teapot seen through a 1e-8 degree window measured 8% of it, since the
-/// hull's f32 vertices, about one window-width of the scene out, place its edges to 6e-8.
+/// silhouette is, and holding the corners it holds the whole window. Slab tests in 3D and in
+/// f64, where the corner directions keep the window's width beside `forward` (1e-10 of it for a
+/// light of 1e-8 degrees). Clipping the projected hull to such a window cannot decide this:
+/// found by black-box testing, the teapot seen through a 1e-8 degree window measured 8% of it,
+/// since the hull's f32 vertices, about one window-width of the scene out, place its edges to
+/// 6e-8.
 fn covers_window(b: &Aabb, eye: Vec3, frame: &Frame, depth: (f32, f32), tan: Vec2) -> bool {
     let wide = |v: Vec3| [v.x, v.y, v.z].map(f64::from);
     let (right, up, forward, eye) = (
@@ -164,9 +165,9 @@ pub const PRECISE_SPAN: f32 = 4096.0;
 /// the image plane `z = 1`: the box is clipped in 3D before anything is projected. Each of its six
 /// faces is clipped (Sutherland-Hodgman) by the near and far planes and the pyramid's four side
 /// planes; the clipped faces' vertices are the clipped solid's, and all of them project into the
-/// window, so no projected point is large whatever `near` is (0 included). Projecting first and clipping
-/// the hull to the window instead loses the window's precision to the long edges of points
-/// near the eye plane (a few 1e-4 of the measure with `near` 0).
+/// window, so no projected point is large whatever `near` is (0 included). Projecting first and
+/// clipping the hull to the window instead loses the window's precision to the long edges of
+/// points near the eye plane (a few 1e-4 of the measure with `near` 0).
 pub fn perspective_window_silhouette(
     b: &Aabb,
     eye: Vec3,

@@ -105,7 +105,8 @@ impl PahPerspective {
         }
     }
 
-    /// The same model without culling to the fields of view.
+    /// The same model without culling to the fields of view and the far plane (boxes are still
+    /// cut at the near plane).
     pub fn unculled(self) -> Self {
         let tan = (self.tan_x, self.tan_y);
         Self {
@@ -513,6 +514,7 @@ mod tests {
         ] {
             let pah = PahPerspective::for_area(&a, m);
             let f = a.frustum().frame.forward;
+            let influence = InfluenceArea::from(a);
             // Boxes about the axis whose far faces lie past the far plane.
             for (centre, half, depth) in [(8.0, 1.0, 3.0), (9.5, 2.5, 1.0), (6.0, 0.5, 8.0)] {
                 let lo = f * centre - Vec3::splat(half);
@@ -520,7 +522,6 @@ mod tests {
                 let m_whole = pah.measure(&whole);
                 // The same box cut by the far plane, sampled: the fraction of window directions
                 // whose ray meets the box before depth 10, times the window's measure.
-                let influence = InfluenceArea::from(a);
                 let mut rays = RaySampler::new(influence, 9).distribution(match m {
                     PerspectiveMeasure::SolidAngle => PointDistribution::SolidAngle,
                     PerspectiveMeasure::ImagePlane => PointDistribution::ImagePlane,

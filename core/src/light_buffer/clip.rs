@@ -45,17 +45,33 @@ impl Region {
         }
     }
 
+    /// True unless all three vertices of `tri` lie outside one plane: a triangle that might reach
+    /// the region (it can still miss it near a corner, which costs a little time, never an
+    /// answer).
+    #[inline]
+    pub fn may_reach(&self, tri: &Triangle) -> bool {
+        let verts = [tri.v0, tri.v1, tri.v2].map(Vec3::as_dvec3);
+        !self.planes[..self.count]
+            .iter()
+            .any(|&(n, c)| verts.iter().all(|&v| n.dot(v) < c))
+    }
+
     /// The box of the part of `tri` inside the region, grown by the margin and kept within the
     /// triangle's own box; `None` when no part of it is inside.
     pub fn clipped_bounds(&self, tri: &Triangle) -> Option<Aabb> {
         let verts = [tri.v0, tri.v1, tri.v2].map(Vec3::as_dvec3);
         let planes = &self.planes[..self.count];
-        // Quick rejection: all three vertices outside one plane.
-        if planes
-            .iter()
-            .any(|&(n, c)| verts.iter().all(|&v| n.dot(v) < c))
-        {
-            return None;
+        // Quick answers: all three vertices outside one plane, or all inside every plane.
+        let mut inside = true;
+        for &(n, c) in planes {
+            let d = verts.map(|v| n.dot(v) >= c);
+            if d == [false; 3] {
+                return None;
+            }
+            inside &= d == [true; 3];
+        }
+        if inside {
+            return Some(tri.bounds());
         }
         let mut poly = [DVec3::ZERO; MAX_CLIPPED];
         let mut next = [DVec3::ZERO; MAX_CLIPPED];
@@ -147,6 +163,9 @@ mod tests {
         let beside = tri([3.0, 3.0, 4.0], [5.0, 3.0, 4.0], [4.0, 5.0, 4.0]);
         assert!(region.clipped_bounds(&beside).is_some());
         let below = tri([-1.0, -1.0, -0.5], [1.0, -1.0, -0.5], [0.0, 1.0, -0.5]);
-        assert!(region.clipped_bounds(&below).is_none(), "behind a one-sided light");
+        assert!(
+            region.clipped_bounds(&below).is_none(),
+            "behind a one-sided light"
+        );
     }
 }

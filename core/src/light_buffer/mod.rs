@@ -27,6 +27,7 @@ mod subdivide;
 
 pub use buffer::{LightBuffer, LightBufferOptions, LightBufferStats};
 pub use source::{LightSource, LightSourceError};
+pub use subdivide::{LightBufferBuilder, LightBufferFace};
 
 #[cfg(test)]
 mod tests;

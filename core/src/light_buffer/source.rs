@@ -39,7 +39,10 @@ impl fmt::Display for LightSourceError {
             LightSourceError::NoPoints => f.write_str("a polygon light needs at least one point"),
             LightSourceError::ZeroDirection => f.write_str("a light normal or axis is zero"),
             LightSourceError::ConeAngle(a) => {
-                write!(f, "a spot's half-angle must be in (0, pi/2] radians, got {a}")
+                write!(
+                    f,
+                    "a spot's half-angle must be in (0, pi/2] radians, got {a}"
+                )
             }
         }
     }

@@ -12,7 +12,8 @@ use crate::random::Pcg32;
 
 /// The thesis's random scene recipe, `n` triangles in `[0, 10]^3`.
 fn soup(n: usize, rng: &mut Pcg32) -> Vec<Triangle> {
-    let mut v = |lo: f32, hi: f32| Vec3::new(rng.range(lo, hi), rng.range(lo, hi), rng.range(lo, hi));
+    let mut v =
+        |lo: f32, hi: f32| Vec3::new(rng.range(lo, hi), rng.range(lo, hi), rng.range(lo, hi));
     (0..n)
         .map(|_| {
             let a = v(0.0, 10.0);
@@ -62,12 +63,15 @@ fn point_lights_answer_every_segment_as_brute_force_does() {
         (Vec3::new(-20.0, 3.0, 40.0), options(8, 1)),
         (tris[7].v1, options(5, 4)),
     ] {
-        let buffer =
-            LightBuffer::build(&tris, LightSource::point(light).unwrap(), &opts).unwrap();
+        let buffer = LightBuffer::build(&tris, LightSource::point(light).unwrap(), &opts).unwrap();
         let rays: Vec<Ray> = (0..3000)
             .map(|_| shadow(point_in(&mut rng, -1.0, 11.0), light))
             .collect();
-        assert_eq!(check(&buffer, &tris, &rays), rays.len(), "every segment answered");
+        assert_eq!(
+            check(&buffer, &tris, &rays),
+            rays.len(),
+            "every segment answered"
+        );
     }
 }
 
@@ -83,14 +87,23 @@ fn face_edges_and_surface_receivers_agree_with_brute_force() {
     for _ in 0..2000 {
         let a = rng.range(-6.0, 6.0);
         let b = rng.range(-6.0, 6.0);
-        for d in [Vec3::new(a, a, b), Vec3::new(a, b, -a), Vec3::new(a, a, a), Vec3::new(b, -b, -b)] {
+        for d in [
+            Vec3::new(a, a, b),
+            Vec3::new(a, b, -a),
+            Vec3::new(a, a, a),
+            Vec3::new(b, -b, -b),
+        ] {
             if d != Vec3::ZERO {
                 rays.push(shadow(light + d, light));
             }
         }
         let t = &tris[(rng.next_u32() % tris.len() as u32) as usize];
         let (u, v) = (rng.next_f32(), rng.next_f32());
-        let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+        let (u, v) = if u + v > 1.0 {
+            (1.0 - u, 1.0 - v)
+        } else {
+            (u, v)
+        };
         let p = t.v0 + (t.v1 - t.v0) * u + (t.v2 - t.v0) * v;
         rays.push(shadow(p, light));
     }
@@ -117,7 +130,10 @@ fn spot_lights_answer_inside_their_cone() {
         })
         .collect();
     let answered = check(&buffer, &tris, &rays);
-    assert!(answered >= inside, "{answered} answered, {inside} inside the cone");
+    assert!(
+        answered >= inside,
+        "{answered} answered, {inside} inside the cone"
+    );
     assert!(buffer.stats().dark_cells > 0, "the cone leaves cells dark");
 }
 
@@ -176,7 +192,10 @@ fn segments_that_do_not_end_on_the_light_are_not_answered() {
     )
     .unwrap();
     let below = Vec3::new(5.2, 1.0, 5.2);
-    assert_eq!(behind.occluded(&shadow(below, light + Vec3::new(0.2, 0.0, 0.2))), None);
+    assert_eq!(
+        behind.occluded(&shadow(below, light + Vec3::new(0.2, 0.0, 0.2))),
+        None
+    );
 }
 
 #[test]
@@ -190,9 +209,48 @@ fn bad_sources_and_options_are_errors() {
     let tris = [Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y)];
     let source = LightSource::point(Vec3::Z).unwrap();
     assert!(LightBuffer::build(&tris, source.clone(), &options(9, 8)).is_err());
-    let bad = [Triangle::new(Vec3::ZERO, Vec3::X, Vec3::splat(f32::INFINITY))];
+    let bad = [Triangle::new(
+        Vec3::ZERO,
+        Vec3::X,
+        Vec3::splat(f32::INFINITY),
+    )];
     assert!(LightBuffer::build(&bad, source.clone(), &options(4, 8)).is_err());
     // An empty scene: every segment is clear.
     let empty = LightBuffer::build(&[], source, &options(4, 8)).unwrap();
     assert_eq!(empty.occluded(&shadow(Vec3::ONE, Vec3::Z)), Some(false));
+}
+
+/// Faces built apart and finished in any order make the same buffer; a face twice, a missing
+/// face or a face of another resolution is an error.
+#[test]
+fn faces_built_apart_make_the_same_buffer() {
+    use super::LightBufferBuilder;
+    let mut rng = Pcg32::new(9);
+    let tris = soup(800, &mut rng);
+    let source = LightSource::point(Vec3::new(4.0, 6.0, 5.0)).unwrap();
+    let opts = options(5, 8);
+    let whole = LightBuffer::build(&tris, source.clone(), &opts).unwrap();
+    let build = LightBufferBuilder::new(&tris, source.clone(), &opts).unwrap();
+    let faces: Vec<_> = (0..LightBufferBuilder::FACES)
+        .rev()
+        .map(|f| build.face(f).unwrap())
+        .collect();
+    assert!(build.face(LightBufferBuilder::FACES).is_err());
+    let mut twice = faces.clone();
+    twice[0] = faces[1].clone();
+    assert!(build.clone().finish(twice).is_err());
+    assert!(build.clone().finish(faces[1..].to_vec()).is_err());
+    let coarse = LightBufferBuilder::new(&tris, source, &options(3, 8)).unwrap();
+    let mut foreign = faces.clone();
+    foreign[2] = coarse.face(LightBufferBuilder::FACES - 3).unwrap();
+    assert!(build.clone().finish(foreign).is_err());
+    let apart = build.finish(faces).unwrap();
+    assert_eq!(apart.stats(), whole.stats());
+    let rays: Vec<Ray> = (0..2000)
+        .map(|_| shadow(point_in(&mut rng, -1.0, 11.0), Vec3::new(4.0, 6.0, 5.0)))
+        .collect();
+    for ray in &rays {
+        assert_eq!(apart.occluded(ray), whole.occluded(ray));
+    }
+    assert_eq!(check(&apart, &tris, &rays), rays.len());
 }

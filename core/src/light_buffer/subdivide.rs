@@ -67,7 +67,7 @@ impl<'a> LightBufferBuilder<'a> {
         if options.max_level > MAX_LEVEL {
             return Err(BuildError::InvalidConfig("light buffer max_level above 8"));
         }
-        if !(options.reference_budget >= 0.0) {
+        if options.reference_budget.is_nan() || options.reference_budget < 0.0 {
             return Err(BuildError::InvalidConfig(
                 "light buffer reference_budget is negative or NaN",
             ));

@@ -71,7 +71,11 @@ impl CellRect {
     /// The face's axis, its sign and the two coordinate axes.
     fn axes(&self) -> (usize, f64, usize, usize) {
         let k = self.face / 2;
-        let sign = if self.face.is_multiple_of(2) { 1.0 } else { -1.0 };
+        let sign = if self.face.is_multiple_of(2) {
+            1.0
+        } else {
+            -1.0
+        };
         (k, sign, (k + 1) % 3, (k + 2) % 3)
     }
 

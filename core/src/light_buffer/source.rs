@@ -9,10 +9,6 @@ use glam::{DVec3, Vec3};
 
 use crate::geometry::{Aabb, Ray};
 
-/// Above this many points, a source's support is taken over the corners of their box (a
-/// superset: still conservative, and cheap for a light made of thousands of triangles).
-const MAX_SUPPORT_POINTS: usize = 64;
-
 /// The relative margin of every geometric decision the buffer makes: distances are grown by
 /// `MARGIN` times the scene's coordinate scale. It dwarfs f32 rounding (about `6e-8` relative),
 /// so rounding in the renderer's light sample, in the segment's end point or in the triangle test
@@ -60,8 +56,8 @@ pub(crate) struct Cone {
 /// A light's surface and the region it illuminates.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightSource {
-    /// The points whose convex hull is the light's surface (one for a point or spot light), or
-    /// the corners of their box when there are many.
+    /// The points whose convex hull the buffer takes as the light's surface: the position of a
+    /// point or spot light, the corners of an area light's box.
     pub(crate) support: Vec<DVec3>,
     /// The box of the light's points.
     pub(crate) bounds: Aabb,
@@ -117,38 +113,40 @@ impl LightSource {
         Ok(s)
     }
 
-    /// An area light whose surface is the convex hull of `points` (a quad's four corners, a
-    /// triangle's three vertices, or every vertex of a group of emissive triangles). With
-    /// `front`, the light is one-sided: it lights only the side its normal `front` points to,
-    /// measured from the lowest of its points along `front`.
+    /// An area light on the convex hull of `points` (a quad's four corners, a triangle's three
+    /// vertices, or every vertex of a group of emissive triangles). With `front`, the light is
+    /// one-sided: it lights only the side its normal `front` points to.
+    ///
+    /// The buffer treats the light as the box of its points, the set its query accepts segment
+    /// ends from: every segment it answers then lies in a cell's region, whatever the hull's
+    /// shape. For the axis-aligned quads of most scenes the box is the quad itself.
     pub fn polygon(points: &[Vec3], front: Option<Vec3>) -> Result<Self, LightSourceError> {
         if points.is_empty() {
             return Err(LightSourceError::NoPoints);
         }
-        let mut support = Vec::with_capacity(points.len().min(MAX_SUPPORT_POINTS));
         for &p in points {
             finite(p)?;
         }
         let bounds = Aabb::from_points(points);
-        if points.len() <= MAX_SUPPORT_POINTS {
-            support.extend(points.iter().map(|p| p.as_dvec3()));
-        } else {
-            let (lo, hi) = (bounds.min.as_dvec3(), bounds.max.as_dvec3());
-            support.extend((0..8).map(|i| {
+        let (lo, hi) = (bounds.min.as_dvec3(), bounds.max.as_dvec3());
+        let support: Vec<DVec3> = (0..8)
+            .map(|i| {
                 DVec3::new(
                     if i & 1 == 0 { lo.x } else { hi.x },
                     if i & 2 == 0 { lo.y } else { hi.y },
                     if i & 4 == 0 { lo.z } else { hi.z },
                 )
-            }));
-        }
+            })
+            .collect();
         let front = match front {
             None => None,
             Some(n) => {
                 let n = unit(n)?;
-                let lowest = points
+                // Measured from the box's lowest corner: a segment ending anywhere in the box
+                // and starting in front stays in front.
+                let lowest = support
                     .iter()
-                    .map(|p| n.dot(p.as_dvec3()))
+                    .map(|&s| n.dot(s))
                     .fold(f64::INFINITY, f64::min);
                 Some((n, lowest))
             }
@@ -160,7 +158,6 @@ impl LightSource {
             cone: None,
         })
     }
-
     /// The box of the light's points.
     pub fn bounds(&self) -> Aabb {
         self.bounds

@@ -169,6 +169,16 @@ fn one_sided_quads_and_many_point_lights_agree_with_brute_force() {
             .collect();
         let answered = check(&buffer, &tris, &rays);
         assert!(answered >= front, "{answered} answered, {front} in front");
+        // Segments that end off the tilted quad but inside its box are answered exactly too.
+        let b = buffer.source().bounds();
+        let off: Vec<Ray> = (0..3000)
+            .map(|_| {
+                let s = b.min
+                    + (b.max - b.min) * Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+                shadow(point_in(&mut rng, -1.0, 11.0), s)
+            })
+            .collect();
+        check(&buffer, &tris, &off);
     }
 }
 

@@ -29,6 +29,7 @@ pub mod error;
 pub mod geometry;
 pub mod heuristics;
 pub mod influence;
+pub mod light_buffer;
 pub mod random;
 pub mod simd;
 pub mod toplevel;

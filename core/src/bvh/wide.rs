@@ -207,6 +207,29 @@ impl WideBvh {
         self.nodes.len() * core::mem::size_of::<WideNode>()
             + self.tris.len() * core::mem::size_of::<Triangle4>()
     }
+
+    /// Appends `other`'s nodes and blocks after this tree's, its indices rebased, and returns the
+    /// index of its root node (`None` for an empty `other`): one allocation holds a forest of
+    /// trees, each traversed from its own root ([`WideBvh::any_hit_from`]), laid out in the order
+    /// they were appended. The result's own root, bounds and root box stay this tree's.
+    pub(crate) fn append(&mut self, other: &WideBvh) -> Option<u32> {
+        if other.nodes.is_empty() {
+            return None;
+        }
+        let (nodes, blocks) = (self.nodes.len() as u32, self.tris.len() as u32);
+        self.nodes.extend(other.nodes.iter().map(|node| {
+            let mut node = *node;
+            for (child, &count) in node.child.iter_mut().zip(&node.count) {
+                if *child != WideNode::EMPTY {
+                    *child += if count == 0 { nodes } else { blocks };
+                }
+            }
+            node
+        }));
+        self.tris.extend_from_slice(&other.tris);
+        self.max_depth = self.max_depth.max(other.max_depth);
+        Some(nodes)
+    }
 }
 
 /// The primitive ids of binary subtree `b` when it is a leaf of at most [`LEAF_BLOCK`] primitives

@@ -310,16 +310,24 @@ impl WideBvh {
         if self.nodes.is_empty() || self.misses_root(ray) {
             return false;
         }
-        self.any_from_root(ray, stats)
+        self.any_from_root(0, ray, stats)
     }
 
-    /// The any-hit traversal proper, out of line (see [`WideBvh::closest_from_root`]).
+    /// [`WideBvh::any_hit_with_stats`] from node `root` of a forest ([`WideBvh::append`]), with no
+    /// root-box test: a tree the caller chose for the ray.
+    #[inline]
+    pub(crate) fn any_hit_from(&self, root: u32, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        self.any_from_root(root, ray, stats)
+    }
+
+    /// The any-hit traversal proper from node `root`, out of line (see
+    /// [`WideBvh::closest_from_root`]).
     #[inline(never)]
-    fn any_from_root(&self, ray: &Ray, stats: &mut impl Counters) -> bool {
+    fn any_from_root(&self, root: u32, ray: &Ray, stats: &mut impl Counters) -> bool {
         let r = Ray4::new(ray);
         let rt = RayTri4::new(ray);
         let mut stack: Stack<(u32, u32), WIDE_STACK> = Stack::new();
-        let (mut child, mut count) = (0u32, 0u32);
+        let (mut child, mut count) = (root, 0u32);
         loop {
             if count == 0 {
                 stats.node();

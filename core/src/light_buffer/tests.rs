@@ -1,0 +1,266 @@
+//! Light buffers against brute force: every answer the buffer gives is the answer over all
+//! triangles, for point, spot, one-sided quad and many-point lights, at every subdivision.
+
+use alloc::vec::Vec;
+
+use glam::Vec3;
+
+use super::{LightBuffer, LightBufferOptions, LightSource};
+use crate::brute_force;
+use crate::geometry::{Ray, Triangle};
+use crate::random::Pcg32;
+
+/// The thesis's random scene recipe, `n` triangles in `[0, 10]^3`.
+fn soup(n: usize, rng: &mut Pcg32) -> Vec<Triangle> {
+    let mut v =
+        |lo: f32, hi: f32| Vec3::new(rng.range(lo, hi), rng.range(lo, hi), rng.range(lo, hi));
+    (0..n)
+        .map(|_| {
+            let a = v(0.0, 10.0);
+            let b = a + v(-1.0, 1.0);
+            let c = b + v(-1.0, 1.0);
+            Triangle::new(a, b, c)
+        })
+        .collect()
+}
+
+fn point_in(rng: &mut Pcg32, lo: f32, hi: f32) -> Vec3 {
+    Vec3::new(rng.range(lo, hi), rng.range(lo, hi), rng.range(lo, hi))
+}
+
+/// A shadow segment from `p` to the light point `s`, ending just short of it.
+fn shadow(p: Vec3, s: Vec3) -> Ray {
+    Ray::segment(p, s - p, 0.0, 1.0 - 1e-4).unwrap()
+}
+
+/// Checks `rays` through `buffer` against brute force; returns how many it answered.
+fn check(buffer: &LightBuffer, tris: &[Triangle], rays: &[Ray]) -> usize {
+    let mut answered = 0;
+    for (i, ray) in rays.iter().enumerate() {
+        if let Some(hit) = buffer.occluded(ray) {
+            assert_eq!(hit, brute_force::any_hit(ray, tris), "ray {i}: {ray:?}");
+            answered += 1;
+        }
+    }
+    answered
+}
+
+fn options(max_level: u32, leaf_triangles: u32) -> LightBufferOptions {
+    LightBufferOptions {
+        max_level,
+        leaf_triangles,
+        ..LightBufferOptions::default()
+    }
+}
+
+#[test]
+fn point_lights_answer_every_segment_as_brute_force_does() {
+    let mut rng = Pcg32::new(1);
+    let tris = soup(1500, &mut rng);
+    for (light, opts) in [
+        (Vec3::new(5.0, 5.0, 5.0), options(6, 8)),
+        (Vec3::new(5.0, 12.0, 5.0), options(3, 32)),
+        (Vec3::new(-20.0, 3.0, 40.0), options(8, 1)),
+        (tris[7].v1, options(5, 4)),
+    ] {
+        let buffer = LightBuffer::build(&tris, LightSource::point(light).unwrap(), &opts).unwrap();
+        let rays: Vec<Ray> = (0..3000)
+            .map(|_| shadow(point_in(&mut rng, -1.0, 11.0), light))
+            .collect();
+        assert_eq!(
+            check(&buffer, &tris, &rays),
+            rays.len(),
+            "every segment answered"
+        );
+    }
+}
+
+/// Directions on the cube map's face edges and corners, and receivers on the triangles.
+#[test]
+fn face_edges_and_surface_receivers_agree_with_brute_force() {
+    let mut rng = Pcg32::new(2);
+    let tris = soup(800, &mut rng);
+    let light = Vec3::new(5.0, 5.0, 5.0);
+    let buffer =
+        LightBuffer::build(&tris, LightSource::point(light).unwrap(), &options(6, 4)).unwrap();
+    let mut rays = Vec::new();
+    for _ in 0..2000 {
+        let a = rng.range(-6.0, 6.0);
+        let b = rng.range(-6.0, 6.0);
+        for d in [
+            Vec3::new(a, a, b),
+            Vec3::new(a, b, -a),
+            Vec3::new(a, a, a),
+            Vec3::new(b, -b, -b),
+        ] {
+            if d != Vec3::ZERO {
+                rays.push(shadow(light + d, light));
+            }
+        }
+        let t = &tris[(rng.next_u32() % tris.len() as u32) as usize];
+        let (u, v) = (rng.next_f32(), rng.next_f32());
+        let (u, v) = if u + v > 1.0 {
+            (1.0 - u, 1.0 - v)
+        } else {
+            (u, v)
+        };
+        let p = t.v0 + (t.v1 - t.v0) * u + (t.v2 - t.v0) * v;
+        rays.push(shadow(p, light));
+    }
+    assert_eq!(check(&buffer, &tris, &rays), rays.len());
+}
+
+#[test]
+fn spot_lights_answer_inside_their_cone() {
+    let mut rng = Pcg32::new(3);
+    let tris = soup(1500, &mut rng);
+    let light = Vec3::new(5.0, 11.0, 5.0);
+    let axis = Vec3::new(0.2, -1.0, 0.1).normalize();
+    let half = 0.5f32;
+    let source = LightSource::spot(light, axis, half).unwrap();
+    let buffer = LightBuffer::build(&tris, source, &options(6, 8)).unwrap();
+    let mut inside = 0;
+    let rays: Vec<Ray> = (0..4000)
+        .map(|_| {
+            let p = point_in(&mut rng, -1.0, 11.0);
+            if (p - light).normalize().dot(axis) >= libm::cosf(half) {
+                inside += 1;
+            }
+            shadow(p, light)
+        })
+        .collect();
+    let answered = check(&buffer, &tris, &rays);
+    assert!(
+        answered >= inside,
+        "{answered} answered, {inside} inside the cone"
+    );
+    assert!(buffer.stats().dark_cells > 0, "the cone leaves cells dark");
+}
+
+#[test]
+fn one_sided_quads_and_many_point_lights_agree_with_brute_force() {
+    let mut rng = Pcg32::new(4);
+    let tris = soup(1500, &mut rng);
+    let corner = Vec3::new(3.0, 10.5, 4.0);
+    let (e1, e2) = (Vec3::new(3.0, 0.0, 0.5), Vec3::new(0.0, -0.4, 2.0));
+    let normal = e1.cross(e2).normalize();
+    let corners = [corner, corner + e1, corner + e1 + e2, corner + e2];
+    // One-sided, and a light of 300 points (its support over their box).
+    let mut many: Vec<Vec3> = (0..300)
+        .map(|_| corner + e1 * rng.next_f32() + e2 * rng.next_f32())
+        .collect();
+    many.extend(corners);
+    for source in [
+        LightSource::polygon(&corners, Some(normal)).unwrap(),
+        LightSource::polygon(&corners, None).unwrap(),
+        LightSource::polygon(&many, Some(normal)).unwrap(),
+    ] {
+        let buffer = LightBuffer::build(&tris, source, &options(5, 8)).unwrap();
+        let mut front = 0;
+        let rays: Vec<Ray> = (0..3000)
+            .map(|_| {
+                let p = point_in(&mut rng, -1.0, 11.0);
+                let s = corner + e1 * rng.next_f32() + e2 * rng.next_f32();
+                if normal.dot(p - corner) > 0.0 {
+                    front += 1;
+                }
+                shadow(p, s)
+            })
+            .collect();
+        let answered = check(&buffer, &tris, &rays);
+        assert!(answered >= front, "{answered} answered, {front} in front");
+        // Segments that end off the tilted quad but inside its box are answered exactly too.
+        let b = buffer.source().bounds();
+        let off: Vec<Ray> = (0..3000)
+            .map(|_| {
+                let s = b.min
+                    + (b.max - b.min) * Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+                shadow(point_in(&mut rng, -1.0, 11.0), s)
+            })
+            .collect();
+        check(&buffer, &tris, &off);
+    }
+}
+
+#[test]
+fn segments_that_do_not_end_on_the_light_are_not_answered() {
+    let mut rng = Pcg32::new(5);
+    let tris = soup(100, &mut rng);
+    let light = Vec3::new(5.0, 5.0, 5.0);
+    let buffer = LightBuffer::build(
+        &tris,
+        LightSource::point(light).unwrap(),
+        &LightBufferOptions::default(),
+    )
+    .unwrap();
+    let ray = Ray::segment(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0), 0.0, 1.0).unwrap();
+    assert_eq!(buffer.occluded(&ray), None);
+    let behind = LightBuffer::build(
+        &tris,
+        LightSource::polygon(&[light, light + Vec3::X, light + Vec3::Z], Some(Vec3::Y)).unwrap(),
+        &LightBufferOptions::default(),
+    )
+    .unwrap();
+    let below = Vec3::new(5.2, 1.0, 5.2);
+    assert_eq!(
+        behind.occluded(&shadow(below, light + Vec3::new(0.2, 0.0, 0.2))),
+        None
+    );
+}
+
+#[test]
+fn bad_sources_and_options_are_errors() {
+    assert!(LightSource::point(Vec3::new(f32::NAN, 0.0, 0.0)).is_err());
+    assert!(LightSource::spot(Vec3::ZERO, Vec3::ZERO, 0.5).is_err());
+    assert!(LightSource::spot(Vec3::ZERO, Vec3::Y, 2.0).is_err());
+    assert!(LightSource::spot(Vec3::ZERO, Vec3::Y, 0.0).is_err());
+    assert!(LightSource::polygon(&[], None).is_err());
+    assert!(LightSource::polygon(&[Vec3::ZERO], Some(Vec3::ZERO)).is_err());
+    let tris = [Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y)];
+    let source = LightSource::point(Vec3::Z).unwrap();
+    assert!(LightBuffer::build(&tris, source.clone(), &options(9, 8)).is_err());
+    let bad = [Triangle::new(
+        Vec3::ZERO,
+        Vec3::X,
+        Vec3::splat(f32::INFINITY),
+    )];
+    assert!(LightBuffer::build(&bad, source.clone(), &options(4, 8)).is_err());
+    // An empty scene: every segment is clear.
+    let empty = LightBuffer::build(&[], source, &options(4, 8)).unwrap();
+    assert_eq!(empty.occluded(&shadow(Vec3::ONE, Vec3::Z)), Some(false));
+}
+
+/// Faces built apart and finished in any order make the same buffer; a face twice, a missing
+/// face or a face of another resolution is an error.
+#[test]
+fn faces_built_apart_make_the_same_buffer() {
+    use super::LightBufferBuilder;
+    let mut rng = Pcg32::new(9);
+    let tris = soup(800, &mut rng);
+    let source = LightSource::point(Vec3::new(4.0, 6.0, 5.0)).unwrap();
+    let opts = options(5, 8);
+    let whole = LightBuffer::build(&tris, source.clone(), &opts).unwrap();
+    let build = LightBufferBuilder::new(&tris, source.clone(), &opts).unwrap();
+    let faces: Vec<_> = (0..LightBufferBuilder::FACES)
+        .rev()
+        .map(|f| build.face(f).unwrap())
+        .collect();
+    assert!(build.face(LightBufferBuilder::FACES).is_err());
+    let mut twice = faces.clone();
+    twice[0] = faces[1].clone();
+    assert!(build.clone().finish(twice).is_err());
+    assert!(build.clone().finish(faces[1..].to_vec()).is_err());
+    let coarse = LightBufferBuilder::new(&tris, source, &options(3, 8)).unwrap();
+    let mut foreign = faces.clone();
+    foreign[2] = coarse.face(LightBufferBuilder::FACES - 3).unwrap();
+    assert!(build.clone().finish(foreign).is_err());
+    let apart = build.finish(faces).unwrap();
+    assert_eq!(apart.stats(), whole.stats());
+    let rays: Vec<Ray> = (0..2000)
+        .map(|_| shadow(point_in(&mut rng, -1.0, 11.0), Vec3::new(4.0, 6.0, 5.0)))
+        .collect();
+    for ray in &rays {
+        assert_eq!(apart.occluded(ray), whole.occluded(ray));
+    }
+    assert_eq!(check(&apart, &tris, &rays), rays.len());
+}

@@ -27,7 +27,7 @@ configs with one name are an error. orientation (parallel, 15deg, 45deg or obliq
 its group of the report; a run without one is in results.csv and the estimate errors by kind, in
 no group table. A config's rays are seeded by its position in the file (the Nth config, whatever
 the others), so a file cut down to some of its configs traces other rays for them.
-Charts have text when a TTF font is found (RDBVH_FONT=path, or DejaVu Sans).")]
+Charts draw their text with the bundled DejaVu Sans (RDBVH_FONT=path.ttf picks another font,\nRDBVH_FONT= with no value draws no text).")]
 pub struct ExperimentArgs {
     /// The experiment file.
     #[arg(value_name = "FILE.toml")]

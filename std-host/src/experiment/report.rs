@@ -124,10 +124,7 @@ pub fn write_report(
         }
     }
     if !fonts_available() {
-        let _ = writeln!(
-            md,
-            "- no TTF font was found (set RDBVH_FONT): charts are drawn without text"
-        );
+        let _ = writeln!(md, "- RDBVH_FONT is empty: charts are drawn without text");
     }
     let k = |i: usize, v: [Option<f64>; 2]| pct(v[i]);
     let _ = writeln!(

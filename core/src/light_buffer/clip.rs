@@ -14,6 +14,14 @@ const MAX_PLANES: usize = 5;
 /// bends the polygon (the clip then stops early with a box that is only larger).
 const MAX_CLIPPED: usize = 16;
 
+/// Where a triangle lies against a region ([`Region::side`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Side {
+    Outside,
+    Inside,
+    Straddles,
+}
+
 /// Points `x` with `n . x >= c` for each plane `(n, c)`: a convex superset of every point that a
 /// segment whose direction lies in the cell can reach from the light's surface.
 #[derive(Clone, Copy, Debug)]
@@ -45,34 +53,43 @@ impl Region {
         }
     }
 
-    /// True unless all three vertices of `tri` lie outside one plane: a triangle that might reach
-    /// the region (it can still miss it near a corner, which costs a little time, never an
-    /// answer).
+    /// Where `tri`'s vertices lie against the region's planes: [`Side::Outside`] when all three
+    /// are outside one plane (the triangle misses the region), [`Side::Inside`] when all are
+    /// inside every plane, else [`Side::Straddles`] (it may still miss near a corner).
+    #[inline]
+    fn side(&self, verts: &[DVec3; 3]) -> Side {
+        let mut inside = true;
+        for &(n, c) in &self.planes[..self.count] {
+            let d = verts.map(|v| n.dot(v) >= c);
+            if d == [false; 3] {
+                return Side::Outside;
+            }
+            inside &= d == [true; 3];
+        }
+        if inside {
+            Side::Inside
+        } else {
+            Side::Straddles
+        }
+    }
+
+    /// True unless [`Region::side`] proves `tri` outside: a triangle that might reach the region
+    /// (one that misses it near a corner costs a little time, never an answer).
     #[inline]
     pub fn may_reach(&self, tri: &Triangle) -> bool {
-        let verts = [tri.v0, tri.v1, tri.v2].map(Vec3::as_dvec3);
-        !self.planes[..self.count]
-            .iter()
-            .any(|&(n, c)| verts.iter().all(|&v| n.dot(v) < c))
+        self.side(&[tri.v0, tri.v1, tri.v2].map(Vec3::as_dvec3)) != Side::Outside
     }
 
     /// The box of the part of `tri` inside the region, grown by the margin and kept within the
     /// triangle's own box; `None` when no part of it is inside.
     pub fn clipped_bounds(&self, tri: &Triangle) -> Option<Aabb> {
         let verts = [tri.v0, tri.v1, tri.v2].map(Vec3::as_dvec3);
+        match self.side(&verts) {
+            Side::Outside => return None,
+            Side::Inside => return Some(tri.bounds()),
+            Side::Straddles => {}
+        }
         let planes = &self.planes[..self.count];
-        // Quick answers: all three vertices outside one plane, or all inside every plane.
-        let mut inside = true;
-        for &(n, c) in planes {
-            let d = verts.map(|v| n.dot(v) >= c);
-            if d == [false; 3] {
-                return None;
-            }
-            inside &= d == [true; 3];
-        }
-        if inside {
-            return Some(tri.bounds());
-        }
         let mut poly = [DVec3::ZERO; MAX_CLIPPED];
         let mut next = [DVec3::ZERO; MAX_CLIPPED];
         poly[..3].copy_from_slice(&verts);

@@ -158,6 +158,7 @@ impl LightSource {
             cone: None,
         })
     }
+
     /// The box of the light's points.
     pub fn bounds(&self) -> Aabb {
         self.bounds

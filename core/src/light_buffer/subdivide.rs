@@ -118,13 +118,11 @@ impl<'a> LightBufferBuilder<'a> {
             out.stats.dark_cells += 1;
             return Ok(out);
         }
-        let all: Vec<u32> = (0..self.tris.len() as u32).collect();
         let refs = reached(
-            &all,
+            0..self.tris.len() as u32,
             self.tris,
             &Region::new(&rect, &self.source, self.margin),
         );
-        drop(all);
         // References held by finished leaves and pending tasks.
         let mut held = refs.len();
         let budget = (f64::from(self.options.reference_budget) * refs.len() as f64) as usize;
@@ -215,17 +213,19 @@ fn split(task: &Task, tris: &[Triangle], source: &LightSource, margin: f64) -> [
             level: task.level + 1,
             i: 2 * task.i + (q & 1) as u32,
             j: 2 * task.j + (q >> 1) as u32,
-            refs: reached(&task.refs, tris, &Region::new(&rect, source, margin)),
+            refs: reached(
+                task.refs.iter().copied(),
+                tris,
+                &Region::new(&rect, source, margin),
+            ),
         }
     })
 }
 
 /// The ids among `refs` whose triangles may reach into `region` ([`Region::may_reach`]; the
 /// leaves clip them exactly).
-fn reached(refs: &[u32], tris: &[Triangle], region: &Region) -> Vec<u32> {
-    refs.iter()
-        .copied()
-        .filter(|&id| region.may_reach(&tris[id as usize]))
+fn reached(refs: impl Iterator<Item = u32>, tris: &[Triangle], region: &Region) -> Vec<u32> {
+    refs.filter(|&id| region.may_reach(&tris[id as usize]))
         .collect()
 }
 

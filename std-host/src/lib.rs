@@ -12,6 +12,7 @@ pub mod cli;
 pub mod clock;
 pub mod experiment;
 pub mod parallel;
+pub mod render;
 pub mod same_file;
 pub mod scene;
 pub mod text_lines;

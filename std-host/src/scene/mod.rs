@@ -20,14 +20,21 @@ pub use room::room;
 
 use rdbvh_core::geometry::{Aabb, Triangle};
 
-/// A material as far as ray distribution cares: its name and how much light it emits.
+/// A material as far as ray distribution and the renderer care: its name, its diffuse colour and
+/// how much light it emits.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     /// The name from `newmtl`.
     pub name: String,
+    /// The MTL `Kd` colour, the Lambertian albedo ([`DEFAULT_DIFFUSE`] when absent).
+    pub diffuse: [f32; 3],
     /// The MTL `Ke` colour (zero when absent).
     pub emission: [f32; 3],
 }
+
+/// The diffuse colour of a material without `Kd`, and of triangles without a material: the MTL
+/// default grey that most exporters write.
+pub const DEFAULT_DIFFUSE: [f32; 3] = [0.8; 3];
 
 impl Material {
     /// A material is a light source when any emission component is positive: that is where next

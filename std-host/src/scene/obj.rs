@@ -24,7 +24,7 @@ use rdbvh_core::geometry::{Aabb, Triangle};
 use rdbvh_core::Vec3;
 
 use super::error::{SceneError, SceneWarning, VertexKind};
-use super::{Material, Scene};
+use super::{Material, Scene, DEFAULT_DIFFUSE};
 
 /// Where the material libraries named by `mtllib` come from.
 #[derive(Clone, Copy, Debug)]
@@ -177,6 +177,7 @@ impl Scene {
             .iter()
             .map(|m| Material {
                 name: m.name.clone(),
+                diffuse: m.diffuse.unwrap_or(DEFAULT_DIFFUSE),
                 emission: m.emissive.unwrap_or([0.0; 3]),
             })
             .collect();

@@ -46,11 +46,11 @@ pub fn room() -> Scene {
     b.cuboid(Vec3::new(8.3, 0.5, 7.8), Vec3::splat(0.5), 0.7, BOX);
 
     let materials = vec![
-        material("white", [0.0; 3]),
-        material("red", [0.0; 3]),
-        material("green", [0.0; 3]),
-        material("light", [17.0, 12.0, 4.0]),
-        material("box", [0.0; 3]),
+        material("white", [0.73; 3], [0.0; 3]),
+        material("red", [0.63, 0.065, 0.05], [0.0; 3]),
+        material("green", [0.14, 0.45, 0.091], [0.0; 3]),
+        material("light", [0.78; 3], [17.0, 12.0, 4.0]),
+        material("box", [0.73; 3], [0.0; 3]),
     ];
     let emissive = b
         .material
@@ -72,9 +72,11 @@ pub fn room() -> Scene {
     }
 }
 
-fn material(name: &str, emission: [f32; 3]) -> Material {
+/// A material with the Cornell box's colours (`diffuse`) and `emission`.
+fn material(name: &str, diffuse: [f32; 3], emission: [f32; 3]) -> Material {
     Material {
         name: name.to_string(),
+        diffuse,
         emission,
     }
 }

@@ -1,0 +1,152 @@
+//! A pinhole camera: `--eye`, `--look-at`, `--up` and a vertical field of view, or a default that
+//! frames the scene's bounds.
+
+use rdbvh_core::geometry::{Aabb, Ray};
+use rdbvh_core::Vec3;
+
+use super::RenderError;
+
+/// The default vertical field of view, in degrees.
+pub const DEFAULT_FOV_DEG: f32 = 50.0;
+
+/// A pinhole camera over a `width x height` image; pixel `(0, 0)` is the top left.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    eye: Vec3,
+    forward: Vec3,
+    right: Vec3,
+    up: Vec3,
+    width: f32,
+    height: f32,
+}
+
+impl Camera {
+    /// A camera at `eye` looking at `look_at`, `up` giving the image's up direction, with a
+    /// vertical field of view of `fov_deg` degrees in (0, 180).
+    pub fn new(
+        eye: Vec3,
+        look_at: Vec3,
+        up: Vec3,
+        fov_deg: f32,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, RenderError> {
+        let bad = |why: String| Err(RenderError::Camera(why));
+        for (name, v) in [("--eye", eye), ("--look-at", look_at), ("--up", up)] {
+            if !v.is_finite() {
+                return bad(format!("{name} must be finite, got {v}"));
+            }
+        }
+        if !(fov_deg > 0.0 && fov_deg < 180.0) {
+            return bad(format!("--fov must be in (0, 180) degrees, got {fov_deg}"));
+        }
+        if width == 0 || height == 0 {
+            return bad(format!(
+                "the image must not be empty, got {width} x {height}"
+            ));
+        }
+        let forward = (look_at - eye).normalize_or_zero();
+        if forward == Vec3::ZERO || !forward.is_finite() {
+            return bad("--eye and --look-at must differ".to_string());
+        }
+        let right = forward.cross(up).normalize_or_zero();
+        if right == Vec3::ZERO || !right.is_finite() {
+            return bad(format!(
+                "--up {up} must not be zero or parallel to the viewing direction"
+            ));
+        }
+        let image_up = right.cross(forward);
+        let tan_y = (fov_deg.to_radians() * 0.5).tan();
+        let tan_x = tan_y * width as f32 / height as f32;
+        Ok(Self {
+            eye,
+            forward,
+            right: right * tan_x,
+            up: image_up * tan_y,
+            width: width as f32,
+            height: height as f32,
+        })
+    }
+
+    /// The default camera: on the `+z` side of `bounds`, looking along `-z` at their centre, `y`
+    /// up, far enough that the box's `+z` face fills the view with a 5 % margin. It frames an
+    /// object, or a room that is open toward `+z` like the Cornell box; a closed room needs a
+    /// camera inside it.
+    pub fn framing(
+        bounds: Aabb,
+        fov_deg: f32,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, RenderError> {
+        let centre = bounds.center();
+        let half = (bounds.max - bounds.min) * 0.5;
+        let tan_y = (fov_deg.to_radians() * 0.5).tan();
+        let aspect = width as f32 / height.max(1) as f32;
+        let fit = (half.y / tan_y).max(half.x / (tan_y * aspect)) * 1.05;
+        // A scene flat in x and y (or a single point) still needs the eye off its face.
+        let distance = fit
+            .max(half.length() * 0.1)
+            .max(1e-3 * centre.abs().max_element())
+            .max(1e-6);
+        let eye = Vec3::new(centre.x, centre.y, bounds.max.z + distance);
+        Self::new(eye, centre, Vec3::Y, fov_deg, width, height)
+    }
+
+    /// The camera's position.
+    pub fn eye(&self) -> Vec3 {
+        self.eye
+    }
+
+    /// The ray through the image point `(x, y)`, in pixels from the top left. Its direction is
+    /// not normalised: hit distances are in units of it, as for every ray in rdbvh.
+    #[inline]
+    pub fn ray(&self, x: f32, y: f32) -> Ray {
+        let sx = 2.0 * x / self.width - 1.0;
+        let sy = 1.0 - 2.0 * y / self.height;
+        let dir = self.forward + self.right * sx + self.up * sy;
+        // The eye is finite and `dir` has a unit component along `forward`: never an error.
+        Ray::new(self.eye, dir).unwrap_or_else(|_| unreachable!("checked camera"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn centre_ray_looks_at_the_target() {
+        let c = Camera::new(Vec3::ZERO, Vec3::new(0.0, 0.0, -5.0), Vec3::Y, 90.0, 4, 2).unwrap();
+        let r = c.ray(2.0, 1.0);
+        assert!((r.dir.normalize() - Vec3::NEG_Z).length() < 1e-6);
+        // The top left corner: 45 degrees up, and twice as far right (aspect 2) at 90 degrees.
+        let corner = c.ray(0.0, 0.0).dir;
+        assert!(
+            (corner - Vec3::new(-2.0, 1.0, -1.0)).length() < 1e-5,
+            "{corner}"
+        );
+    }
+
+    #[test]
+    fn bad_cameras_are_refused_by_name() {
+        let make = |eye, at, up, fov| Camera::new(eye, at, up, fov, 8, 8).unwrap_err().to_string();
+        assert!(make(Vec3::ZERO, Vec3::ZERO, Vec3::Y, 45.0).contains("--look-at"));
+        assert!(make(Vec3::ZERO, Vec3::Y, Vec3::Y, 45.0).contains("--up"));
+        assert!(make(Vec3::ZERO, Vec3::Z, Vec3::Y, 180.0).contains("--fov"));
+        assert!(make(Vec3::ZERO, Vec3::Z, Vec3::Y, f32::NAN).contains("--fov"));
+        assert!(make(Vec3::splat(f32::NAN), Vec3::Z, Vec3::Y, 45.0).contains("--eye"));
+    }
+
+    #[test]
+    fn framing_sees_the_whole_box() {
+        let b = Aabb::new(Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 2.0, 1.0));
+        let c = Camera::framing(b, 50.0, 64, 64).unwrap();
+        assert!(c.eye().z > 1.0);
+        // The rays through the image corners pass outside the box's front face.
+        for (x, y) in [(0.0, 0.0), (64.0, 64.0)] {
+            let r = c.ray(x, y);
+            let t = (1.0 - r.origin.z) / r.dir.z;
+            let p = r.at(t);
+            assert!(p.x.abs() >= 1.0 && (p.y - 1.0).abs() >= 1.0, "{p}");
+        }
+    }
+}

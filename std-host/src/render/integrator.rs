@@ -1,0 +1,319 @@
+//! Path tracing with next event estimation over Lambertian surfaces.
+//!
+//! At every vertex: one light chosen by power, one point on it, one shadow segment; then a
+//! cosine-weighted bounce, with Russian roulette from the third vertex on. Emission is added where
+//! a camera ray lands on an emissive triangle; a bounce ray that lands on one adds nothing,
+//! because next event estimation already counted that light (no double counting, no MIS).
+
+use std::f32::consts::{FRAC_1_PI, TAU};
+
+use rdbvh_core::bvh::{Hit, TraversalStats};
+use rdbvh_core::geometry::{Ray, Triangle};
+use rdbvh_core::Vec3;
+
+use super::sampler::{vertex_dim, Sampler};
+use super::{LightSet, RenderError, Structure};
+use crate::scene::{Scene, DEFAULT_DIFFUSE};
+
+/// Where a shadow segment ends: `origin + (1 - SHADOW_END) * (target - origin)`. The light's own
+/// surface (an emissive triangle) is then never its occluder, while anything in front of it is:
+/// the gap is a 10^-4 part of the segment.
+pub const SHADOW_END: f32 = 1e-4;
+
+/// Ray origins leave a surface along its normal by this fraction of the scene's largest
+/// coordinate, which is where f32 rounding puts a hit point off its triangle.
+pub const OFFSET_SCALE: f32 = 1e-4;
+
+/// The first vertex (counting the camera ray's hit as 0) where Russian roulette may end a path.
+pub const ROULETTE_DEPTH: u32 = 2;
+
+/// A shadow segment the renderer traced, with its light and its answer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowRay {
+    /// The index of its light in the renderer's light set.
+    pub light: u32,
+    /// The segment.
+    pub ray: Ray,
+    /// Whether something blocked it.
+    pub occluded: bool,
+}
+
+/// What one path tells the frame besides its radiance: its rays, for the counters and records.
+pub trait PathObserver {
+    /// A camera (`depth == 0`) or bounce ray and its closest hit.
+    fn closest(&mut self, depth: u32, ray: &Ray, hit: Option<&Hit>);
+    /// A shadow segment, its answer, and the tests it cost.
+    fn shadow(&mut self, shadow: &ShadowRay, stats: &TraversalStats);
+}
+
+/// Everything a path needs, shared by every thread.
+pub struct Integrator<'a> {
+    triangles: &'a [Triangle],
+    /// Per triangle, its material's diffuse colour and emission.
+    albedo: Vec<Vec3>,
+    emission: Vec<Vec3>,
+    lights: &'a LightSet,
+    structure: &'a Structure,
+    max_bounces: u32,
+    offset: f32,
+}
+
+impl<'a> Integrator<'a> {
+    /// The integrator for `scene` lit by `lights`, tracing through `structure`. Fails on a
+    /// material colour that is negative or not finite.
+    pub fn new(
+        scene: &'a Scene,
+        lights: &'a LightSet,
+        structure: &'a Structure,
+        max_bounces: u32,
+    ) -> Result<Self, RenderError> {
+        for m in &scene.materials {
+            for (field, c) in [("Kd", m.diffuse), ("Ke", m.emission)] {
+                if c.iter().any(|x| !x.is_finite() || *x < 0.0) {
+                    return Err(RenderError::Material {
+                        name: m.name.clone(),
+                        reason: format!(
+                            "`{field}` must be finite and non-negative, got {} {} {}",
+                            c[0], c[1], c[2]
+                        ),
+                    });
+                }
+            }
+        }
+        let material = |i: usize| scene.materials.get(scene.material[i] as usize);
+        let albedo = (0..scene.len())
+            .map(|i| Vec3::from(material(i).map_or(DEFAULT_DIFFUSE, |m| m.diffuse)))
+            .collect();
+        let emission = (0..scene.len())
+            .map(|i| Vec3::from(material(i).map_or([0.0; 3], |m| m.emission)))
+            .collect();
+        let b = scene.bounds;
+        let scale = b.min.abs().max(b.max.abs()).max_element();
+        Ok(Self {
+            triangles: &scene.triangles,
+            albedo,
+            emission,
+            lights,
+            structure,
+            max_bounces,
+            offset: (OFFSET_SCALE * scale).max(f32::MIN_POSITIVE),
+        })
+    }
+
+    /// The radiance a path started by `camera_ray` carries back, drawing its numbers from
+    /// `sampler`; its rays go to `observer`.
+    pub fn radiance(
+        &self,
+        camera_ray: Ray,
+        sampler: &Sampler,
+        observer: &mut impl PathObserver,
+    ) -> Vec3 {
+        let mut radiance = Vec3::ZERO;
+        let mut throughput = Vec3::ONE;
+        let mut ray = camera_ray;
+        for depth in 0..=self.max_bounces {
+            let hit = self.structure.closest_hit(&ray);
+            observer.closest(depth, &ray, hit.as_ref());
+            let Some(hit) = hit else { break };
+            let id = hit.triangle as usize;
+            let t = &self.triangles[id];
+            // The hit point from the barycentrics: on the triangle up to rounding, wherever the
+            // ray started.
+            let p = t.v0 + (t.v1 - t.v0) * hit.u + (t.v2 - t.v0) * hit.v;
+            let mut n = (t.v1 - t.v0).cross(t.v2 - t.v0).normalize_or_zero();
+            if n == Vec3::ZERO {
+                break;
+            }
+            // Both faces are surfaces: shade the one the ray arrived at.
+            if n.dot(ray.dir) > 0.0 {
+                n = -n;
+            }
+            if depth == 0 {
+                radiance += throughput * self.emission[id];
+            }
+            let albedo = self.albedo[id];
+            let origin = p + n * self.offset;
+            let dim = vertex_dim(depth);
+
+            let (light, probability) = self.lights.choose(sampler.get(dim));
+            let sample = self.lights.lights()[light].sample(
+                self.triangles,
+                origin,
+                sampler.get(dim + 1),
+                sampler.get(dim + 2),
+            );
+            if let Some(s) = sample {
+                let d = s.target - origin;
+                let cos = n.dot(d);
+                if cos > 0.0 {
+                    if let Ok(segment) = Ray::segment(origin, d, 0.0, 1.0 - SHADOW_END) {
+                        let mut stats = TraversalStats::default();
+                        let occluded = self.structure.occluded_counted(light, &segment, &mut stats);
+                        let shadow = ShadowRay {
+                            light: light as u32,
+                            ray: segment,
+                            occluded,
+                        };
+                        observer.shadow(&shadow, &stats);
+                        if !occluded {
+                            radiance += throughput
+                                * albedo
+                                * s.weight
+                                * (FRAC_1_PI * cos / (d.length() * probability));
+                        }
+                    }
+                }
+            }
+
+            if depth == self.max_bounces {
+                break;
+            }
+            // Lambertian with cosine-weighted directions: f cos / pdf = albedo.
+            throughput *= albedo;
+            if depth >= ROULETTE_DEPTH {
+                let survive = throughput.max_element().min(0.95);
+                if sampler.get(dim + 5) >= survive {
+                    break;
+                }
+                throughput /= survive;
+            }
+            let dir = cosine_direction(n, sampler.get(dim + 3), sampler.get(dim + 4));
+            match Ray::new(origin, dir) {
+                Ok(r) => ray = r,
+                Err(_) => break,
+            }
+        }
+        radiance
+    }
+}
+
+/// A direction about the unit normal `n` with density `cos / pi` (Malley's method on an
+/// orthonormal basis from Duff et al. 2017).
+#[inline]
+fn cosine_direction(n: Vec3, u: f32, v: f32) -> Vec3 {
+    let sign = 1.0f32.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    let tangent = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    let bitangent = Vec3::new(b, sign + n.y * n.y * a, -n.y);
+    let r = u.sqrt();
+    let phi = TAU * v;
+    let (x, y) = (r * phi.cos(), r * phi.sin());
+    let z = (1.0 - u).max(0.0).sqrt();
+    tangent * x + bitangent * y + n * z
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::{Light, StructureKind};
+    use crate::scene::Material;
+    use rdbvh_core::geometry::Aabb;
+
+    /// Counts nothing.
+    struct Ignore;
+    impl PathObserver for Ignore {
+        fn closest(&mut self, _: u32, _: &Ray, _: Option<&Hit>) {}
+        fn shadow(&mut self, _: &ShadowRay, _: &TraversalStats) {}
+    }
+
+    /// A 20 x 20 floor at y = 0 with albedo 0.5.
+    fn floor() -> Scene {
+        let (a, b, c, d) = (
+            Vec3::new(-10.0, 0.0, -10.0),
+            Vec3::new(10.0, 0.0, -10.0),
+            Vec3::new(10.0, 0.0, 10.0),
+            Vec3::new(-10.0, 0.0, 10.0),
+        );
+        let triangles = vec![Triangle::new(a, b, c), Triangle::new(a, c, d)];
+        Scene {
+            name: "floor".into(),
+            bounds: triangles
+                .iter()
+                .fold(Aabb::EMPTY, |x, t| x.union(t.bounds())),
+            triangles,
+            material: vec![0, 0],
+            emissive: vec![false, false],
+            materials: vec![Material {
+                name: "grey".into(),
+                diffuse: [0.5; 3],
+                emission: [0.0; 3],
+            }],
+            warnings: vec![],
+            material_files: vec![],
+        }
+    }
+
+    #[test]
+    fn direct_light_from_a_point_matches_the_closed_form() {
+        // Kd / pi * I * cos / r^2 at the point below a light 2 units up and 1 unit aside.
+        let scene = floor();
+        let light = Light::Point {
+            position: Vec3::new(1.0, 2.0, 0.0),
+            intensity: Vec3::new(10.0, 20.0, 30.0),
+        };
+        let lights = LightSet::new(vec![light], &scene.triangles).unwrap();
+        let structure =
+            Structure::build(StructureKind::Global, &scene.triangles, lights.lights()).unwrap();
+        let integrator = Integrator::new(&scene, &lights, &structure, 0).unwrap();
+        let ray = Ray::new(Vec3::new(0.0, 5.0, 0.0), Vec3::NEG_Y).unwrap();
+        let l = integrator.radiance(ray, &Sampler::new(1, 0, 0), &mut Ignore);
+        let (r2, cos) = (5.0f32, 2.0 / 5.0f32.sqrt());
+        let expected = 0.5 * FRAC_1_PI * Vec3::new(10.0, 20.0, 30.0) * cos / r2;
+        assert!(
+            (l - expected).length() < 1e-3 * expected.length(),
+            "{l} vs {expected}"
+        );
+    }
+
+    #[test]
+    fn an_open_floor_reflects_nothing_onto_itself() {
+        // Bounce rays off a plane never come back to it: every bounce count gives the direct
+        // light's answer, bit for bit, whatever the random numbers.
+        let scene = floor();
+        let light = Light::Point {
+            position: Vec3::new(0.0, 1.0, 0.0),
+            intensity: Vec3::ONE,
+        };
+        let lights = LightSet::new(vec![light], &scene.triangles).unwrap();
+        let structure =
+            Structure::build(StructureKind::Global, &scene.triangles, lights.lights()).unwrap();
+        let direct = Integrator::new(&scene, &lights, &structure, 0).unwrap();
+        let ray = Ray::new(Vec3::new(0.0, 0.5, 0.0), Vec3::new(0.3, -1.0, 0.1)).unwrap();
+        let a = direct.radiance(ray, &Sampler::new(3, 0, 0), &mut Ignore);
+        assert!(a.min_element() > 0.0);
+        let bounced = Integrator::new(&scene, &lights, &structure, 5).unwrap();
+        for s in 0..64 {
+            assert_eq!(
+                bounced.radiance(ray, &Sampler::new(3, 0, s), &mut Ignore),
+                a
+            );
+        }
+    }
+
+    #[test]
+    fn cosine_directions_lie_in_the_hemisphere_with_mean_cosine_two_thirds() {
+        for n in [
+            Vec3::Y,
+            Vec3::NEG_Z,
+            Vec3::new(0.6, 0.0, 0.8),
+            Vec3::new(0.0, 0.0, -1.0),
+        ] {
+            let mut sum = 0.0;
+            let k = 64;
+            for i in 0..k {
+                for j in 0..k {
+                    let d = cosine_direction(
+                        n,
+                        (i as f32 + 0.5) / k as f32,
+                        (j as f32 + 0.5) / k as f32,
+                    );
+                    assert!((d.length() - 1.0).abs() < 1e-4 && d.dot(n) >= 0.0, "{d}");
+                    sum += d.dot(n);
+                }
+            }
+            let mean = sum / (k * k) as f32;
+            assert!((mean - 2.0 / 3.0).abs() < 0.01, "{n}: {mean}");
+        }
+    }
+}

@@ -1,0 +1,45 @@
+//! `rdbvh render`: a path tracer with next event estimation, the workload the ray-distribution
+//! heuristics are for, and the structures that make its shadow rays cheaper.
+//!
+//! # Rendering
+//!
+//! - **Scene.** OBJ + MTL through the scene loader: each triangle's MTL `Kd` is its Lambertian
+//!   albedo (textures are not read), its `Ke` its emission. Shading uses geometric normals, both
+//!   faces of every triangle.
+//! - **Lights.** Emissive triangles (both faces), plus point, hard-edged spot and one-sided quad
+//!   lights from a lights file ([`lights_file`]). Next event estimation chooses one light per
+//!   vertex in proportion to its power ([`Light::power`]) and one point on it.
+//! - **Integrator.** Path tracing with one shadow segment per vertex, cosine-weighted bounces,
+//!   Russian roulette from the third vertex ([`integrator`]).
+//! - **Determinism.** Every random number is a hash of (seed, pixel, sample, dimension)
+//!   ([`sampler`]): the image depends on the seed alone, not on threads or tiles.
+//! - **Structures.** Camera and bounce rays go through the global BVH; shadow segments through
+//!   the [`Structure`] chosen (`global`, or `lights`: a light buffer per light). Both answer
+//!   exactly as the global BVH does, so their images are byte-identical.
+//! - **Measures.** The frame counts its rays and the shadow segments' node and triangle tests;
+//!   [`replay_shadow_rays`] times the frame's shadow segments on one thread.
+
+mod camera;
+mod error;
+mod frame;
+mod image;
+pub mod integrator;
+mod light;
+mod light_structure;
+pub mod lights_file;
+mod replay;
+pub mod sampler;
+mod structure;
+
+pub use self::image::{encode_png, mean_luminance, srgb, to_srgb8};
+pub use camera::{Camera, DEFAULT_FOV_DEG};
+pub use error::RenderError;
+pub use frame::{
+    render_frame, Frame, FrameCounters, FrameSettings, RecordedRays, REPLAY_CAP, TILE,
+};
+pub use integrator::{Integrator, ShadowRay, SHADOW_END};
+pub use light::{emissive_lights, luminance, Light, LightSample, LightSet};
+pub use light_structure::{CLUSTER_EXTENT, MAX_LIGHT_BUFFERS};
+pub use lights_file::{parse_lights, read_lights};
+pub use replay::replay_shadow_rays;
+pub use structure::{Structure, StructureKind};

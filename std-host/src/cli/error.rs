@@ -42,6 +42,8 @@ pub enum CliError {
     Mismatch(String),
     /// An experiment or analysis failed.
     Experiment(crate::experiment::ExperimentError),
+    /// A render could not start or finish.
+    Render(crate::render::RenderError),
 }
 
 impl fmt::Display for CliError {
@@ -59,6 +61,7 @@ impl fmt::Display for CliError {
             CliError::Stdout(e) => write!(f, "cannot write to standard output: {e}"),
             CliError::Mismatch(what) => write!(f, "BVH disagrees with brute force: {what}"),
             CliError::Experiment(e) => e.fmt(f),
+            CliError::Render(e) => e.fmt(f),
         }
     }
 }
@@ -75,6 +78,7 @@ impl std::error::Error for CliError {
             | CliError::Usage(_)
             | CliError::Mismatch(_) => None,
             CliError::Experiment(e) => Some(e),
+            CliError::Render(e) => Some(e),
         }
     }
 }
@@ -125,5 +129,11 @@ impl From<PresetError> for CliError {
 impl From<crate::experiment::ExperimentError> for CliError {
     fn from(e: crate::experiment::ExperimentError) -> Self {
         CliError::Experiment(e)
+    }
+}
+
+impl From<crate::render::RenderError> for CliError {
+    fn from(e: crate::render::RenderError) -> Self {
+        CliError::Render(e)
     }
 }

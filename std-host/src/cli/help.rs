@@ -102,3 +102,64 @@ pub fn trace() -> String {
          {SCENES}"
     )
 }
+
+/// `rdbvh render --help`.
+pub fn render() -> String {
+    format!(
+        "What is modelled: Lambertian surfaces with the MTL Kd colour (textures are not read; a\n\
+         material without Kd, or a triangle without a material, is 0.8 grey), geometric normals,\n\
+         both faces of every triangle. Lights: emissive MTL Ke triangles (area lights, emitting\n\
+         from both faces) and the lights file's point, spot (hard-edged cone) and quad lights\n\
+         (one-sided, toward edge1 x edge2; not geometry, so the camera does not see them). No\n\
+         environment light: rays that leave the scene are black.\n\
+         Integrator: path tracing with next event estimation. At every vertex one light is chosen\n\
+         in proportion to its power and one point on it (uniform by area), and one shadow segment\n\
+         is traced, from the point offset along the normal by 1e-4 of the scene's largest\n\
+         coordinate to 1 - 1e-4 of the way to the light sample; then a cosine-weighted bounce,\n\
+         with Russian roulette from the third vertex on. Emission is added where a camera ray\n\
+         lands; bounce rays add none (next event estimation counted it). Each random number is a\n\
+         hash of (seed, pixel, sample, dimension), so an image depends on --seed alone, not on\n\
+         --threads. The image is the mean of --spp samples, clamped to [0, 1], sRGB-encoded, 8\n\
+         bits; 16 x 16 tiles run on the threads, with a progress bar when standard error is a\n\
+         terminal.\n\
+         Structures: camera and bounce rays go through the global BVH (binned SAH, reinsertion,\n\
+         4-wide nodes). Shadow segments go through --structure: global, the same BVH; lights, a\n\
+         light buffer per light (a cube map of directions around it, each cell holding a BVH of\n\
+         what segments toward the light through that cell can hit; emissive triangles are\n\
+         clustered per material, at most 32 buffers, for the most powerful lights), with the\n\
+         global BVH for segments a buffer does not take. Both answer exactly as the global BVH\n\
+         does: the images are byte-identical.\n\
+         shadow_ms is the best of --shadow-replays single-thread replays of the frame's shadow\n\
+         segments (its first 2097152 when it has more) through the structure alone, without\n\
+         counters; the replay's answers must equal the frame's.\n\
+         --json prints one object as the last line, with the keys scene, triangles, lights,\n\
+         light_buffers, width, height, spp, max_bounces, seed, threads, structure, build_ms,\n\
+         render_ms, camera_rays, shadow_rays, bounce_rays, shadow_occluded, shadow_node_tests,\n\
+         shadow_triangle_tests, shadow_replay_rays, shadow_ms, mean_luminance and out.\n\
+         --record-rays DIR writes the first --record-limit rays of each kind (in tile order, then\n\
+         pixel, sample and path vertex) as `rdbvh trace --rays` reads them, with the renderer's\n\
+         answers as `rdbvh trace --out` writes them: replay shadow_rays.csv with --any-hit.\n\n\
+         Lights file (TOML), one [[light]] table per light, every field required:\n  \
+         [[light]]\n  \
+         kind = \"point\"\n  \
+         position = [0.0, 1.9, 0.0]\n  \
+         intensity = [5.0, 5.0, 5.0]       # radiant intensity, RGB, non-negative\n  \
+         [[light]]\n  \
+         kind = \"spot\"\n  \
+         position = [0.0, 1.9, 0.0]\n  \
+         direction = [0.0, -1.0, 0.0]\n  \
+         angle_deg = 30.0                  # the cone's half-angle, in (0, 90]\n  \
+         intensity = [5.0, 5.0, 5.0]\n  \
+         [[light]]\n  \
+         kind = \"quad\"                     # one-sided: emits toward edge1 x edge2\n  \
+         corner = [-0.25, 1.98, -0.25]\n  \
+         edge1 = [0.5, 0.0, 0.0]\n  \
+         edge2 = [0.0, 0.0, 0.5]\n  \
+         radiance = [10.0, 10.0, 10.0]\n\n\
+         Examples:\n  \
+         rdbvh render cornell_box.obj --spp 64 --out cornell.png\n  \
+         rdbvh render builtin:room --eye 5,5,9.5 --look-at 5,4,0 --fov 70 --structure lights --json\n  \
+         rdbvh render sponza.obj --lights lights.toml --record-rays rays/ --record-limit 10000\n\n\
+         {SCENES}"
+    )
+}

@@ -15,6 +15,7 @@ mod error;
 mod experiment;
 mod help;
 mod rays;
+mod render;
 mod structure;
 mod trace;
 
@@ -23,7 +24,8 @@ pub use build::{BuildArgs, BuildReport};
 pub use builder::{chooser_name, BuilderArgs, BuilderKind, BuiltBvh, PresetArg};
 pub use error::CliError;
 pub use experiment::ExperimentArgs;
-pub use rays::{parse_rays, read_rays, RaysError, OPTIONAL_COLUMNS, REQUIRED_COLUMNS};
+pub use rays::{parse_rays, read_rays, write_rays, RaysError, OPTIONAL_COLUMNS, REQUIRED_COLUMNS};
+pub use render::{RenderArgs, RenderReport, StructureArg};
 pub use structure::{trace_structure, StructureTrace, DEFAULT_LOCAL_PRESET};
 pub use trace::{trace, Answers, LookupKind, TraceArgs};
 
@@ -60,6 +62,10 @@ pub enum Command {
     Experiment(ExperimentArgs),
     /// Build over each influence area of a scene and print every analyzer metric.
     Analyze(AnalyzeArgs),
+    /// Path trace a scene with next event estimation (point, spot, quad and emissive lights),
+    /// write a PNG, and report what its shadow rays cost through the structure chosen.
+    #[command(after_help = help::render())]
+    Render(RenderArgs),
 }
 
 /// Runs the command line `args` (the first item is the program name) and returns the exit
@@ -81,6 +87,7 @@ where
         Some(Command::Trace(args)) => trace::run(args, &mut io::stderr()),
         Some(Command::Experiment(args)) => experiment::run(args, &mut out),
         Some(Command::Analyze(args)) => analyze::run(args, &mut out),
+        Some(Command::Render(args)) => render::run(args, &mut out),
     };
     let result = result.and_then(|()| out.flush().map_err(CliError::Stdout));
     match result {

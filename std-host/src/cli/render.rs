@@ -1,0 +1,361 @@
+//! `rdbvh render`: path trace a scene with next event estimation, write the PNG, and report
+//! the shadow rays' cost through the structure chosen.
+
+use std::fs;
+use std::io::{BufWriter, IsTerminal, Write};
+use std::path::{Path, PathBuf};
+
+use clap::{value_parser, Args, ValueEnum};
+use rdbvh_core::Vec3;
+use serde::Serialize;
+
+use super::rays::write_rays;
+use super::trace::Answers;
+use super::{load_scene, CliError};
+use crate::render::{
+    emissive_lights, encode_png, mean_luminance, read_lights, render_frame, replay_shadow_rays,
+    to_srgb8, Camera, FrameSettings, Integrator, LightSet, RecordedRays, RenderError, Structure,
+    StructureKind, DEFAULT_FOV_DEG,
+};
+
+/// `--structure`: which structure answers the shadow rays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum StructureArg {
+    /// The global BVH: binned SAH with reinsertion, 4-wide nodes.
+    Global,
+    /// A light buffer per light (per cluster of emissive triangles), built from the lights; the
+    /// global BVH answers what a buffer does not.
+    Lights,
+}
+
+impl From<StructureArg> for StructureKind {
+    fn from(s: StructureArg) -> Self {
+        match s {
+            StructureArg::Global => StructureKind::Global,
+            StructureArg::Lights => StructureKind::Lights,
+        }
+    }
+}
+
+/// Arguments of `rdbvh render`.
+#[derive(Args, Clone, Debug)]
+pub struct RenderArgs {
+    /// The scene: an OBJ file (with its MTL), or builtin:NAME for a built-in scene.
+    #[arg(value_name = "SCENE.obj")]
+    pub scene: String,
+    /// Point, spot and quad lights (TOML, one [[light]] table each), added to the scene's
+    /// emissive triangles.
+    #[arg(long, value_name = "LIGHTS.toml")]
+    pub lights: Option<PathBuf>,
+    /// Where to write the image (PNG).
+    #[arg(long, value_name = "FILE.png", default_value = "render.png")]
+    pub out: PathBuf,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 512, value_parser = value_parser!(u32).range(1..=16384))]
+    pub width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 512, value_parser = value_parser!(u32).range(1..=16384))]
+    pub height: u32,
+    /// Samples per pixel.
+    #[arg(long, default_value_t = 16, value_parser = value_parser!(u32).range(1..=1_000_000))]
+    pub spp: u32,
+    /// Bounces after the camera ray's hit; 0 is direct light only.
+    #[arg(long, value_name = "N", default_value_t = 3, value_parser = value_parser!(u32).range(0..=1000))]
+    pub max_bounces: u32,
+    /// The seed of every random number: the image depends on it alone.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Worker threads (0: every core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// The camera's position [default: in front of the scene's +z face, framing its bounds]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<Vec3>,
+    /// The point the camera looks at [default: the centre of the scene's bounds]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub look_at: Option<Vec3>,
+    /// The image's up direction [default: 0,1,0]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub up: Option<Vec3>,
+    /// Vertical field of view in degrees, in (0, 180).
+    #[arg(long, value_name = "DEG", default_value_t = DEFAULT_FOV_DEG)]
+    pub fov: f32,
+    /// Which structure answers the shadow rays (camera and bounce rays always use the global
+    /// BVH); every structure gives the same image, byte for byte.
+    #[arg(long, value_enum, default_value_t = StructureArg::Global)]
+    pub structure: StructureArg,
+    /// Single-thread replays of the frame's shadow rays for shadow_ms (the best one counts).
+    #[arg(long, value_name = "N", default_value_t = 5, value_parser = value_parser!(u32).range(1..=100))]
+    pub shadow_replays: u32,
+    /// Write the first rays of each kind with the renderer's answers to DIR (created if
+    /// missing): camera_rays.csv + camera_hits.csv, bounce_rays.csv + bounce_hits.csv,
+    /// shadow_rays.csv + shadow_hits.csv.
+    #[arg(long, value_name = "DIR")]
+    pub record_rays: Option<PathBuf>,
+    /// With --record-rays: how many rays of each kind.
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 100_000,
+        requires = "record_rays"
+    )]
+    pub record_limit: usize,
+    /// Print the report as one JSON object, the last line of standard output.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `X,Y,Z`: three finite numbers.
+fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let xs: Result<Vec<f32>, _> = s.split(',').map(|x| x.trim().parse::<f32>()).collect();
+    match xs.as_deref() {
+        Ok(&[x, y, z]) if [x, y, z].iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
+        _ => Err(format!("expected three finite numbers X,Y,Z, got `{s}`")),
+    }
+}
+
+/// The report of one render (`--json` prints it as one object).
+#[derive(Clone, Debug, Serialize)]
+pub struct RenderReport {
+    /// The scene's name.
+    pub scene: String,
+    /// Its triangles.
+    pub triangles: usize,
+    /// Lights the renderer samples (emissive triangles and the lights file's).
+    pub lights: usize,
+    /// Light buffers built (0 for `global`).
+    pub light_buffers: usize,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Bounces after the first hit.
+    pub max_bounces: u32,
+    /// The seed.
+    pub seed: u64,
+    /// Threads that rendered.
+    pub threads: usize,
+    /// `global` or `lights`.
+    pub structure: &'static str,
+    /// Wall-clock milliseconds of the structure's build (global BVH and light buffers).
+    pub build_ms: f64,
+    /// Wall-clock milliseconds of the frame.
+    pub render_ms: f64,
+    /// Camera rays traced.
+    pub camera_rays: u64,
+    /// Shadow segments traced.
+    pub shadow_rays: u64,
+    /// Bounce rays traced.
+    pub bounce_rays: u64,
+    /// Shadow segments that something blocked.
+    pub shadow_occluded: u64,
+    /// Inner nodes the shadow segments visited, 4-wide nodes for both structures (a light
+    /// buffer's cell lookup counts as one).
+    pub shadow_node_tests: u64,
+    /// Ray/triangle tests of the shadow segments.
+    pub shadow_triangle_tests: u64,
+    /// Shadow segments in the replay (the frame's first, at most `REPLAY_CAP`).
+    pub shadow_replay_rays: usize,
+    /// Best single-thread time of the replay, in milliseconds.
+    pub shadow_ms: f64,
+    /// Mean Rec. 709 luminance of the linear image.
+    pub mean_luminance: f64,
+    /// The PNG written.
+    pub out: String,
+}
+
+/// Runs `rdbvh render`, printing the report to `out`.
+pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
+    let mut inputs = vec![Path::new(&args.scene)];
+    inputs.extend(args.lights.as_deref());
+    super::check_output(&args.out, &inputs)?;
+    if let Some(dir) = &args.record_rays {
+        fs::create_dir_all(dir).map_err(|source| CliError::Write {
+            path: dir.clone(),
+            source,
+        })?;
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads)
+        .build()
+        .map_err(|e| CliError::Usage(format!("cannot start {} threads: {e}", args.threads)))?;
+    let report = pool.install(|| render(args))?;
+    if !args.json {
+        return print_summary(&report, out).map_err(CliError::Stdout);
+    }
+    print_summary(&report, out)
+        .and_then(|()| {
+            let json = serde_json::to_string(&report).map_err(std::io::Error::other)?;
+            writeln!(out, "{json}")
+        })
+        .map_err(CliError::Stdout)
+}
+
+/// Loads, builds, renders, replays and writes; runs on the command's thread pool.
+fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
+    let (scene, _) = load_scene(&args.scene, Some(&args.out))?;
+    let mut lights = emissive_lights(&scene);
+    if let Some(path) = &args.lights {
+        lights.extend(read_lights(path)?);
+    }
+    let lights = LightSet::new(lights, &scene.triangles).ok_or_else(|| RenderError::NoLights {
+        scene: scene.name.clone(),
+    })?;
+    let framing = Camera::framing(scene.bounds, args.fov, args.width, args.height)?;
+    let camera = Camera::new(
+        args.eye.unwrap_or(framing.eye()),
+        args.look_at.unwrap_or(scene.bounds.center()),
+        args.up.unwrap_or(Vec3::Y),
+        args.fov,
+        args.width,
+        args.height,
+    )?;
+    let structure = Structure::build(args.structure.into(), &scene.triangles, lights.lights())?;
+    let integrator = Integrator::new(&scene, &lights, &structure, args.max_bounces)?;
+    let settings = FrameSettings {
+        width: args.width,
+        height: args.height,
+        spp: args.spp,
+        seed: args.seed,
+        record_limit: if args.record_rays.is_some() {
+            args.record_limit
+        } else {
+            0
+        },
+        progress: std::io::stderr().is_terminal(),
+    };
+    let frame = render_frame(&integrator, &camera, &settings);
+    let shadow_ms = replay_shadow_rays(&structure, &frame.shadow_rays, args.shadow_replays)?;
+
+    let png = encode_png(&to_srgb8(&frame.pixels), args.width, args.height)?;
+    fs::write(&args.out, png).map_err(|source| CliError::Write {
+        path: args.out.clone(),
+        source,
+    })?;
+    if let Some(dir) = &args.record_rays {
+        write_records(dir, &frame.recorded)?;
+    }
+    let c = frame.counters;
+    Ok(RenderReport {
+        scene: scene.name.clone(),
+        triangles: scene.len(),
+        lights: lights.lights().len(),
+        light_buffers: structure.light_buffers().len(),
+        width: args.width,
+        height: args.height,
+        spp: args.spp,
+        max_bounces: args.max_bounces,
+        seed: args.seed,
+        threads: rayon::current_num_threads(),
+        structure: structure.kind().name(),
+        build_ms: structure.build_ms(),
+        render_ms: frame.render_ms,
+        camera_rays: c.camera_rays,
+        shadow_rays: c.shadow_rays,
+        bounce_rays: c.bounce_rays,
+        shadow_occluded: c.shadow_occluded,
+        shadow_node_tests: c.shadow_node_tests,
+        shadow_triangle_tests: c.shadow_triangle_tests,
+        shadow_replay_rays: frame.shadow_rays.len(),
+        shadow_ms,
+        mean_luminance: mean_luminance(&frame.pixels),
+        out: args.out.display().to_string(),
+    })
+}
+
+/// Writes the recorded rays and answers in the formats `rdbvh trace` reads and writes.
+fn write_records(dir: &Path, r: &RecordedRays) -> Result<(), CliError> {
+    let write = |name: &str, f: &dyn Fn(&mut BufWriter<fs::File>) -> std::io::Result<()>| {
+        let path = dir.join(name);
+        let fail = |source| CliError::Write {
+            path: path.clone(),
+            source,
+        };
+        let mut w = BufWriter::new(fs::File::create(&path).map_err(fail)?);
+        f(&mut w).and_then(|()| w.flush()).map_err(fail)
+    };
+    for (kind, rays) in [("camera", &r.camera), ("bounce", &r.bounce)] {
+        write(&format!("{kind}_rays.csv"), &|w| {
+            write_rays(w, rays.iter().map(|(ray, _)| ray))
+        })?;
+        let hits = Answers::Closest(rays.iter().map(|(_, hit)| *hit).collect());
+        write(&format!("{kind}_hits.csv"), &|w| hits.write_csv(w))?;
+    }
+    write("shadow_rays.csv", &|w| {
+        write_rays(w, r.shadow.iter().map(|s| &s.ray))
+    })?;
+    let hits = Answers::Any(r.shadow.iter().map(|s| s.occluded).collect());
+    write("shadow_hits.csv", &|w| hits.write_csv(w))
+}
+
+/// The human summary: what was rendered, rays per second of each kind, the shadow replay.
+fn print_summary(r: &RenderReport, out: &mut impl Write) -> std::io::Result<()> {
+    let per_second = |n: u64, ms: f64| n as f64 / (ms * 1e-3).max(1e-9);
+    writeln!(
+        out,
+        "{}: {} triangles, {} lights, {}x{} at {} spp, {} bounces, seed {}, {} threads",
+        r.scene, r.triangles, r.lights, r.width, r.height, r.spp, r.max_bounces, r.seed, r.threads
+    )?;
+    writeln!(
+        out,
+        "structure {}: built in {:.1} ms{}",
+        r.structure,
+        r.build_ms,
+        if r.light_buffers > 0 {
+            format!(" ({} light buffers)", r.light_buffers)
+        } else {
+            String::new()
+        }
+    )?;
+    writeln!(
+        out,
+        "frame {:.1} ms: rays per second of the frame",
+        r.render_ms
+    )?;
+    for (kind, n) in [
+        ("camera", r.camera_rays),
+        ("bounce", r.bounce_rays),
+        ("shadow", r.shadow_rays),
+    ] {
+        writeln!(
+            out,
+            "  {kind:<7} {n:>11} rays  {:>7.2} Mrays/s",
+            per_second(n, r.render_ms) * 1e-6
+        )?;
+    }
+    let per_ray = |x: u64| x as f64 / r.shadow_rays.max(1) as f64;
+    writeln!(
+        out,
+        "shadow rays: {:.1} % blocked, {:.2} nodes + {:.2} triangles a ray; replay of {} on one \
+         thread {:.1} ms ({:.2} Mrays/s)",
+        100.0 * per_ray(r.shadow_occluded),
+        per_ray(r.shadow_node_tests),
+        per_ray(r.shadow_triangle_tests),
+        r.shadow_replay_rays,
+        r.shadow_ms,
+        per_second(r.shadow_replay_rays as u64, r.shadow_ms) * 1e-6
+    )?;
+    writeln!(
+        out,
+        "wrote {} (mean luminance {:.4})",
+        r.out, r.mean_luminance
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vectors_parse_with_signs_and_spaces() {
+        assert_eq!(
+            parse_vec3("-1, 2.5,3e1").unwrap(),
+            Vec3::new(-1.0, 2.5, 30.0)
+        );
+        for bad in ["1,2", "1,2,3,4", "a,b,c", "nan,0,0", "inf,0,0", ""] {
+            assert!(parse_vec3(bad).is_err(), "{bad}");
+        }
+    }
+}

@@ -37,9 +37,7 @@ impl Camera {
                 return bad(format!("{name} must be finite, got {v}"));
             }
         }
-        if !(fov_deg > 0.0 && fov_deg < 180.0) {
-            return bad(format!("--fov must be in (0, 180) degrees, got {fov_deg}"));
-        }
+        check_fov(fov_deg)?;
         if width == 0 || height == 0 {
             return bad(format!(
                 "the image must not be empty, got {width} x {height}"
@@ -78,6 +76,7 @@ impl Camera {
         width: u32,
         height: u32,
     ) -> Result<Self, RenderError> {
+        check_fov(fov_deg)?;
         let centre = bounds.center();
         let half = (bounds.max - bounds.min) * 0.5;
         let tan_y = (fov_deg.to_radians() * 0.5).tan();
@@ -106,6 +105,17 @@ impl Camera {
         let dir = self.forward + self.right * sx + self.up * sy;
         // The eye is finite and `dir` has a unit component along `forward`: never an error.
         Ray::new(self.eye, dir).unwrap_or_else(|_| unreachable!("checked camera"))
+    }
+}
+
+/// A vertical field of view must be in (0, 180) degrees.
+fn check_fov(fov_deg: f32) -> Result<(), RenderError> {
+    if fov_deg > 0.0 && fov_deg < 180.0 {
+        Ok(())
+    } else {
+        Err(RenderError::Camera(format!(
+            "--fov must be in (0, 180) degrees, got {fov_deg}"
+        )))
     }
 }
 

@@ -1,0 +1,321 @@
+//! End-to-end tests of `rdbvh render`: determinism across threads and structures, the `--json`
+//! contract, recorded rays that replay through `rdbvh trace` and agree with brute force, and
+//! one-line errors for bad lights and cameras.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use rdbvh::cli::read_rays;
+use rdbvh::scene::Scene;
+use rdbvh_core::brute_force;
+
+fn rdbvh(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rdbvh"))
+        .args(args)
+        .output()
+        .expect("the rdbvh binary runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// The shared scenes beside the workspace, or `None` (with a note) when they are not checked out.
+/// Under `CI=true` their absence is a failure, not a skip.
+fn shared_scenes(test: &str) -> Option<PathBuf> {
+    let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/scenes"));
+    if dir.is_dir() {
+        return Some(dir.to_path_buf());
+    }
+    assert!(
+        std::env::var("CI").as_deref() != Ok("true"),
+        "CI=true but {} is missing",
+        dir.display()
+    );
+    eprintln!(
+        "{test}: real scenes skipped: {} not found (check out ../shared beside the workspace)",
+        dir.display()
+    );
+    None
+}
+
+/// A fresh scratch folder for one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("rdbvh-render-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The room seen from inside, small and fast.
+const ROOM: [&str; 10] = [
+    "builtin:room",
+    "--eye",
+    "5,5,0.3",
+    "--look-at",
+    "5,4,10",
+    "--fov",
+    "75",
+    "--width",
+    "40",
+    "--height",
+];
+
+/// Renders with `extra` arguments to `png` and returns the `--json` object.
+fn render(scene: &[&str], png: &Path, extra: &[&str]) -> serde_json::Value {
+    let mut args = vec!["render"];
+    args.extend(scene);
+    let png = png.to_str().unwrap();
+    args.extend(["--out", png, "--json"]);
+    args.extend(extra);
+    let out = rdbvh(&args);
+    assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    let last = stdout.lines().last().expect("a report");
+    serde_json::from_str(last).unwrap_or_else(|e| panic!("{e}: {last}"))
+}
+
+fn room() -> Vec<&'static str> {
+    let mut a = ROOM.to_vec();
+    a.extend(["32", "--spp", "2"]);
+    a
+}
+
+#[test]
+fn images_depend_on_the_seed_alone_whatever_the_threads_and_structure() {
+    let dir = scratch("determinism");
+    let scene = room();
+    let one = render(&scene, &dir.join("one.png"), &["--threads", "1"]);
+    let two = render(&scene, &dir.join("two.png"), &["--threads", "2"]);
+    let lights = render(&scene, &dir.join("lights.png"), &["--structure", "lights"]);
+    let other = render(&scene, &dir.join("seed.png"), &["--seed", "2"]);
+    let png = |n: &str| std::fs::read(dir.join(n)).unwrap();
+    assert_eq!(png("one.png"), png("two.png"));
+    assert_eq!(png("one.png"), png("lights.png"));
+    assert_ne!(png("one.png"), png("seed.png"));
+    for key in [
+        "camera_rays",
+        "bounce_rays",
+        "shadow_rays",
+        "shadow_occluded",
+        "mean_luminance",
+    ] {
+        assert_eq!(one[key], two[key], "{key}");
+        assert_eq!(one[key], lights[key], "{key}");
+    }
+    assert_ne!(one["mean_luminance"], other["mean_luminance"]);
+    assert_eq!(one["structure"], "global");
+    assert_eq!(lights["structure"], "lights");
+    assert_eq!(one["light_buffers"], 0);
+    assert!(lights["light_buffers"].as_u64().unwrap() >= 1);
+    // The light buffer saves triangle tests on the room's shadow rays.
+    assert!(lights["shadow_triangle_tests"].as_u64() < one["shadow_triangle_tests"].as_u64());
+}
+
+#[test]
+fn json_has_the_contract_keys() {
+    let dir = scratch("json");
+    let json = render(&room(), &dir.join("r.png"), &["--max-bounces", "0"]);
+    for key in [
+        "width",
+        "height",
+        "spp",
+        "structure",
+        "build_ms",
+        "render_ms",
+        "camera_rays",
+        "shadow_rays",
+        "bounce_rays",
+        "shadow_node_tests",
+        "shadow_triangle_tests",
+        "shadow_ms",
+        "mean_luminance",
+        "scene",
+        "triangles",
+        "lights",
+        "max_bounces",
+        "seed",
+        "threads",
+    ] {
+        assert!(json.get(key).is_some(), "{key} missing: {json}");
+    }
+    assert_eq!(json["width"], 40);
+    assert_eq!(json["height"], 32);
+    assert_eq!(json["camera_rays"], 40 * 32 * 2);
+    assert_eq!(
+        json["bounce_rays"], 0,
+        "--max-bounces 0 is direct light only"
+    );
+    assert!(json["mean_luminance"].as_f64().unwrap() > 0.0);
+    let png = image::open(dir.join("r.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (40, 32));
+}
+
+#[test]
+fn recorded_rays_replay_through_trace_and_agree_with_brute_force() {
+    let dir = scratch("record");
+    let rays = dir.join("rays");
+    let json = render(
+        &room(),
+        &dir.join("r.png"),
+        &[
+            "--record-rays",
+            rays.to_str().unwrap(),
+            "--record-limit",
+            "500",
+        ],
+    );
+    let scene = Scene::open("builtin:room").unwrap();
+    for kind in ["camera", "bounce", "shadow"] {
+        let file = rays.join(format!("{kind}_rays.csv"));
+        let recorded = read_rays(&file).unwrap();
+        assert_eq!(recorded.len(), 500, "{kind}");
+        let hits = std::fs::read_to_string(rays.join(format!("{kind}_hits.csv"))).unwrap();
+        let rows: Vec<&str> = hits.lines().skip(1).collect();
+        assert_eq!(rows.len(), 500);
+        for (ray, row) in recorded.iter().zip(&rows) {
+            let cells: Vec<&str> = row.split(',').collect();
+            if kind == "shadow" {
+                assert_eq!(
+                    cells[1] == "1",
+                    brute_force::any_hit(ray, &scene.triangles),
+                    "{row}"
+                );
+            } else {
+                let truth = brute_force::closest_hit(ray, &scene.triangles);
+                assert_eq!(
+                    cells[2].parse::<u32>().ok(),
+                    truth.map(|h| h.triangle),
+                    "{row}"
+                );
+            }
+        }
+        // `rdbvh trace` answers the recorded rays with the same bytes.
+        let replay = dir.join(format!("{kind}_replay.csv"));
+        let mut args = vec!["trace", "builtin:room", "--rays", file.to_str().unwrap()];
+        args.extend(["--out", replay.to_str().unwrap()]);
+        if kind == "shadow" {
+            args.push("--any-hit");
+        }
+        let out = rdbvh(&args);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        assert_eq!(std::fs::read_to_string(&replay).unwrap(), hits, "{kind}");
+    }
+    assert!(json["shadow_rays"].as_u64().unwrap() >= 500);
+}
+
+/// Runs `render` with `args` and returns its one-line error.
+fn error_of(args: &[&str]) -> String {
+    let out = rdbvh(args);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    let err = text(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+#[test]
+fn bad_lights_cameras_and_scenes_are_one_line_errors() {
+    let dir = scratch("errors");
+    let lights = dir.join("lights.toml");
+    let out = dir.join("x.png");
+    let (l, o) = (lights.to_str().unwrap(), out.to_str().unwrap());
+    for (file, expected) in [
+        (
+            "[[light]]\nkind = \"laser\"\n",
+            "light 0: unknown kind `laser`",
+        ),
+        (
+            "[[light]]\nkind = \"spot\"\nposition = [5, 9, 5]\ndirection = [0, -1, 0]\n\
+             angle_deg = 95\nintensity = [1, 1, 1]\n",
+            "light 0 (spot): `angle_deg` must be in (0, 90], got 95",
+        ),
+        (
+            "[[light]]\nkind = \"quad\"\ncorner = [0, 0, 0]\nedge1 = [1, 0, 0]\n\
+             edge2 = [-1, 0, 0]\nradiance = [1, 1, 1]\n",
+            "light 0 (quad): `edge1` [1, 0, 0] and `edge2` [-1, 0, 0] span no area",
+        ),
+        (
+            "[[light]]\nkind = \"point\"\nposition = [5, 5, 5]\n",
+            "missing field `intensity`",
+        ),
+        ("not toml [", "lights file"),
+    ] {
+        std::fs::write(&lights, file).unwrap();
+        let err = error_of(&["render", "builtin:room", "--lights", l, "--out", o]);
+        assert!(err.contains(expected), "{file:?}: {err}");
+    }
+    let missing = dir.join("missing.toml");
+    let err = error_of(&[
+        "render",
+        "builtin:room",
+        "--lights",
+        missing.to_str().unwrap(),
+        "--out",
+        o,
+    ]);
+    assert!(err.contains("cannot read lights file"), "{err}");
+    std::fs::write(&lights, "").unwrap();
+    let err = error_of(&["render", "builtin:random100", "--lights", l, "--out", o]);
+    assert!(err.contains("has no light"), "{err}");
+    let err = error_of(&[
+        "render",
+        "builtin:room",
+        "--eye",
+        "1,2,3",
+        "--look-at",
+        "1,2,3",
+        "--out",
+        o,
+    ]);
+    assert!(err.contains("--look-at"), "{err}");
+    let err = error_of(&["render", "builtin:room", "--fov", "0", "--out", o]);
+    assert!(err.contains("--fov"), "{err}");
+    let err = error_of(&["render", "builtin:room", "--eye", "1,nan,3", "--out", o]);
+    assert!(err.contains("--eye"), "{err}");
+    let err = error_of(&["render", "builtin:room", "--out", dir.to_str().unwrap()]);
+    assert!(err.contains("folder"), "{err}");
+    assert!(!out.exists(), "no image is written on an error");
+}
+
+#[test]
+fn cornell_box_with_every_light_kind_is_identical_across_structures() {
+    let Some(scenes) = shared_scenes("cornell_box_with_every_light_kind") else {
+        return;
+    };
+    let dir = scratch("cornell");
+    let lights = dir.join("lights.toml");
+    std::fs::write(
+        &lights,
+        "[[light]]\nkind = \"point\"\nposition = [0.5, 1.5, 0.3]\nintensity = [1, 1, 1]\n\
+         [[light]]\nkind = \"spot\"\nposition = [-0.5, 1.8, 0.5]\ndirection = [0.3, -1, -0.4]\n\
+         angle_deg = 25\nintensity = [3, 2, 1]\n\
+         [[light]]\nkind = \"quad\"\ncorner = [-0.9, 0.2, -1.0]\nedge1 = [0, 0.4, 0]\n\
+         edge2 = [0.3, 0, 0]\nradiance = [0, 2, 4]\n",
+    )
+    .unwrap();
+    let obj = scenes.join("cornell_box.obj");
+    let scene = [
+        obj.to_str().unwrap(),
+        "--width",
+        "48",
+        "--height",
+        "48",
+        "--spp",
+        "2",
+    ];
+    let l = ["--lights", lights.to_str().unwrap()];
+    let global = render(&scene, &dir.join("g.png"), &l);
+    let mut args = l.to_vec();
+    args.extend(["--structure", "lights"]);
+    let buffered = render(&scene, &dir.join("l.png"), &args);
+    assert_eq!(
+        std::fs::read(dir.join("g.png")).unwrap(),
+        std::fs::read(dir.join("l.png")).unwrap()
+    );
+    assert_eq!(
+        global["lights"], 5,
+        "2 emissive triangles and 3 lights from the file"
+    );
+    assert_eq!(global["shadow_occluded"], buffered["shadow_occluded"]);
+    assert!(global["mean_luminance"].as_f64().unwrap() > 0.01);
+}

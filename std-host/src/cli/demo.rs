@@ -7,6 +7,7 @@
 //! is checked against brute force, so a first run both shows the tool and proves it works here.
 
 use std::io::Write;
+use std::path::Path;
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -19,6 +20,9 @@ use rdbvh_core::toplevel::{Scene as Structure, SceneOptions, DEFAULT_OCTREE_LEVE
 use rdbvh_core::Vec3;
 
 use super::builder::{BuilderArgs, BuilderKind, BuiltBvh};
+use clap::Parser;
+
+use super::render::{render, RenderReport};
 use super::structure::trace_structure;
 use super::trace::{trace, Answers};
 use super::{load_scene, CliError};
@@ -34,8 +38,16 @@ struct Batch {
     any_hit: bool,
 }
 
-/// Runs the demo, writing what it does to `out`.
+/// The image the demo renders, in the current folder.
+pub const DEMO_IMAGE: &str = "rdbvh-room.png";
+
+/// Runs the demo, writing what it does to `out` and the rendered room to [`DEMO_IMAGE`].
 pub fn run(out: &mut impl Write) -> Result<(), CliError> {
+    run_with(out, Path::new(DEMO_IMAGE))
+}
+
+/// [`run`], writing the rendered room to `image`.
+pub fn run_with(out: &mut impl Write, image: &Path) -> Result<(), CliError> {
     let w = |out: &mut dyn Write, text: String| writeln!(out, "{text}").map_err(CliError::Stdout);
     w(
         out,
@@ -104,6 +116,7 @@ pub fn run(out: &mut impl Write) -> Result<(), CliError> {
         }
     }
     checked += structure(out)?;
+    render_room(out, image)?;
     w(
         out,
         format!(
@@ -112,6 +125,83 @@ pub fn run(out: &mut impl Write) -> Result<(), CliError> {
             super::count(rayon::current_num_threads(), "thread")
         ),
     )
+}
+
+/// The camera of the demo's render: inside the room, looking past the boxes at the back wall.
+const ROOM_CAMERA: [&str; 6] = ["--eye", "5,5,0.3", "--look-at", "5,4,10", "--fov", "75"];
+
+/// Renders the room with next event estimation through both structures, checks that the images
+/// are byte-identical, writes one, and prints what the shadow rays cost through each.
+fn render_room(out: &mut impl Write, image: &Path) -> Result<(), CliError> {
+    let w = |out: &mut dyn Write, text: String| writeln!(out, "{text}").map_err(CliError::Stdout);
+    let image_arg = image.to_string_lossy();
+    let mut command = vec!["render", "builtin:room"];
+    command.extend(ROOM_CAMERA);
+    command.extend(["--width", "256", "--height", "256", "--spp", "8"]);
+    command.extend(["--out", &image_arg]);
+    w(
+        out,
+        format!(
+            "\nrender (next event estimation): rdbvh {} --structure global|lights",
+            command.join(" ")
+        ),
+    )?;
+    super::check_output(image, &[])?;
+    let mut reports: Vec<(RenderReport, Vec<u8>)> = Vec::new();
+    for structure in ["global", "lights"] {
+        let mut line = vec!["rdbvh"];
+        line.extend(&command);
+        line.extend(["--structure", structure]);
+        let args = match super::Cli::try_parse_from(&line).map(|c| c.command) {
+            Ok(Some(super::Command::Render(args))) => args,
+            _ => return Err(CliError::Mismatch("the demo's render command line".into())),
+        };
+        let report = render(&args)?;
+        let png = std::fs::read(image).map_err(|source| CliError::Write {
+            path: image.to_path_buf(),
+            source,
+        })?;
+        reports.push((report, png));
+    }
+    let [(global, global_png), (lights, lights_png)] = &reports[..] else {
+        unreachable!("two structures rendered");
+    };
+    if global_png != lights_png || global.shadow_occluded != lights.shadow_occluded {
+        return Err(CliError::Mismatch(
+            "the lights structure's image differs from the global BVH's".into(),
+        ));
+    }
+    w(
+        out,
+        format!(
+            "  {} camera, {} bounce, {} shadow rays; the same image, byte for byte, from both \
+             structures: {}",
+            global.camera_rays,
+            global.bounce_rays,
+            global.shadow_rays,
+            image.display()
+        ),
+    )?;
+    w(
+        out,
+        "  structure  build ms  nodes + triangles a shadow ray  shadow rays, 1 thread".into(),
+    )?;
+    for r in [global, lights] {
+        let per_ray = |x: u64| x as f64 / r.shadow_rays.max(1) as f64;
+        w(
+            out,
+            format!(
+                "  {:<9}  {:>8.1}  {:>12.2} + {:<16.2}  {:>7.1} ms ({:.2}x global)",
+                r.structure,
+                r.build_ms,
+                per_ray(r.shadow_node_tests),
+                per_ray(r.shadow_triangle_tests),
+                r.shadow_ms,
+                r.shadow_ms / global.shadow_ms.max(1e-9)
+            ),
+        )?;
+    }
+    Ok(())
 }
 
 /// The room's influence area: parallel rays straight down from just below the 2 x 2 ceiling

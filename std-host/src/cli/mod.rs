@@ -225,7 +225,9 @@ mod tests {
     #[test]
     fn demo_passes() {
         let mut out = Vec::new();
-        demo::run(&mut out).unwrap();
+        let image = std::env::temp_dir().join(format!("rdbvh-demo-{}.png", std::process::id()));
+        demo::run_with(&mut out, &image).unwrap();
+        assert!(image.is_file());
         let text = String::from_utf8(out).unwrap();
         assert!(text.contains("agree with brute force"), "{text}");
     }

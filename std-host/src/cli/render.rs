@@ -193,8 +193,8 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
         .map_err(CliError::Stdout)
 }
 
-/// Loads, builds, renders, replays and writes; runs on the command's thread pool.
-fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
+/// Loads, builds, renders, replays and writes; runs on the current thread pool.
+pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
     let (scene, _) = load_scene(&args.scene, Some(&args.out))?;
     let mut lights = emissive_lights(&scene);
     if let Some(path) = &args.lights {

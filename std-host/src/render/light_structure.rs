@@ -19,7 +19,7 @@ use super::{Light, RenderError};
 pub const MAX_LIGHT_BUFFERS: usize = 32;
 
 /// The widest cluster of emissive triangles, as a fraction of the scene's diagonal.
-pub const CLUSTER_EXTENT: f32 = 0.1;
+pub const CLUSTER_EXTENT: f32 = 0.25;
 
 /// The most clusters formed before the remaining emissive triangles go without a buffer, which
 /// bounds the clustering's quadratic search.
@@ -137,7 +137,7 @@ mod tests {
                 Vec3::new(x, 0.1, 0.0),
             )
         };
-        // Two neighbours, one far away: the scene spans 10 units, clusters at most 1.
+        // Two neighbours, one far away: the scene spans 10 units, clusters at most 2.5.
         let triangles = [tri(0.0), tri(0.2), tri(9.9)];
         let emissive = |t: u32, r: f32| Light::Emissive {
             triangle: t,

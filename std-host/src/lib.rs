@@ -3,7 +3,7 @@
 //!
 //! The core crate is `no_std` so it can run in embedded renderers; everything that needs files,
 //! threads or clocks lives here, organised by the user's jobs: [`scene`] loads what to trace,
-//! [`cli`] is the command line.
+//! [`render`] path traces it with next event estimation, [`cli`] is the command line.
 #![deny(missing_docs)]
 #![forbid(unsafe_code)]
 
@@ -21,3 +21,8 @@ pub mod text_lines;
 #[cfg(doctest)]
 #[doc = include_str!("../../README.md")]
 pub struct ReadmeDoctests;
+
+/// The library guide's Rust examples, compiled as doctests too.
+#[cfg(doctest)]
+#[doc = include_str!("../../docs/library.md")]
+pub struct LibraryDoctests;

@@ -43,6 +43,9 @@ RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps
 
 section "tests (cargo test --workspace --release)"
 cargo test --workspace --release 2>&1 | tee "$LOG_DIR/test.log"
+cargo run --release -q -p rdbvh-core --example trace_mesh >/dev/null
+cargo run --release -q -p rdbvh-core --example influence_area >/dev/null
+cargo run --release -q -p rdbvh-core --example no_std_renderer >/dev/null
 
 section "no_std: rdbvh-core for $TARGET"
 cargo build -p rdbvh-core --release --target "$TARGET"

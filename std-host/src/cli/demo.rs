@@ -22,9 +22,10 @@ use rdbvh_core::Vec3;
 use super::builder::{BuilderArgs, BuilderKind, BuiltBvh};
 use clap::Parser;
 
+use super::answers::Answers;
 use super::render::{render, RenderReport};
 use super::structure::trace_structure;
-use super::trace::{trace, Answers};
+use super::trace::trace;
 use super::{load_scene, CliError};
 use crate::scene::{Mt19937, Scene};
 

@@ -7,6 +7,7 @@
 //! error, `error: ...`, and a non-zero exit status: 2 for a bad command line, 1 for anything else.
 
 mod analyze;
+mod answers;
 mod areas;
 mod build;
 mod builder;
@@ -20,6 +21,7 @@ mod structure;
 mod trace;
 
 pub use analyze::{AnalyzeArgs, NODE_COLUMNS};
+pub use answers::Answers;
 pub use build::{BuildArgs, BuildReport};
 pub use builder::{chooser_name, BuilderArgs, BuilderKind, BuiltBvh, PresetArg};
 pub use error::CliError;
@@ -27,7 +29,7 @@ pub use experiment::ExperimentArgs;
 pub use rays::{parse_rays, read_rays, write_rays, RaysError, OPTIONAL_COLUMNS, REQUIRED_COLUMNS};
 pub use render::{RenderArgs, RenderReport, StructureArg};
 pub use structure::{trace_structure, StructureTrace, DEFAULT_LOCAL_PRESET};
-pub use trace::{trace, Answers, LookupKind, TraceArgs};
+pub use trace::{trace, LookupKind, TraceArgs};
 
 use std::ffi::OsString;
 use std::io::{self, Write};
@@ -84,7 +86,10 @@ where
     let result = match &cli.command {
         None => demo::run(&mut out),
         Some(Command::Build(args)) => build::run(args, &mut out),
-        Some(Command::Trace(args)) => trace::run(args, &mut io::stderr()),
+        Some(Command::Trace(args)) => match &args.areas {
+            Some(areas) => structure::run(args, areas, &mut io::stderr()),
+            None => trace::run(args, &mut io::stderr()),
+        },
         Some(Command::Experiment(args)) => experiment::run(args, &mut out),
         Some(Command::Analyze(args)) => analyze::run(args, &mut out),
         Some(Command::Render(args)) => render::run(args, &mut out),

@@ -6,11 +6,12 @@ use std::io::{BufWriter, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 
 use clap::{value_parser, Args, ValueEnum};
+use rdbvh_core::geometry::Ray;
 use rdbvh_core::Vec3;
 use serde::Serialize;
 
+use super::answers::{write_answers, Answers};
 use super::rays::write_rays;
-use super::trace::Answers;
 use super::{load_scene, CliError};
 use crate::render::{
     emissive_lights, encode_png, mean_luminance, read_lights, render_frame, replay_shadow_rays,
@@ -267,27 +268,28 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
 
 /// Writes the recorded rays and answers in the formats `rdbvh trace` reads and writes.
 fn write_records(dir: &Path, r: &RecordedRays) -> Result<(), CliError> {
-    let write = |name: &str, f: &dyn Fn(&mut BufWriter<fs::File>) -> std::io::Result<()>| {
+    let rays = |name: &str, rays: &mut dyn Iterator<Item = &Ray>| {
         let path = dir.join(name);
         let fail = |source| CliError::Write {
             path: path.clone(),
             source,
         };
         let mut w = BufWriter::new(fs::File::create(&path).map_err(fail)?);
-        f(&mut w).and_then(|()| w.flush()).map_err(fail)
+        write_rays(&mut w, rays)
+            .and_then(|()| w.flush())
+            .map_err(fail)
     };
-    for (kind, rays) in [("camera", &r.camera), ("bounce", &r.bounce)] {
-        write(&format!("{kind}_rays.csv"), &|w| {
-            write_rays(w, rays.iter().map(|(ray, _)| ray))
-        })?;
-        let hits = Answers::Closest(rays.iter().map(|(_, hit)| *hit).collect());
-        write(&format!("{kind}_hits.csv"), &|w| hits.write_csv(w))?;
+    for (kind, recorded) in [("camera", &r.camera), ("bounce", &r.bounce)] {
+        rays(
+            &format!("{kind}_rays.csv"),
+            &mut recorded.iter().map(|(ray, _)| ray),
+        )?;
+        let hits = Answers::Closest(recorded.iter().map(|(_, hit)| *hit).collect());
+        write_answers(&dir.join(format!("{kind}_hits.csv")), &hits)?;
     }
-    write("shadow_rays.csv", &|w| {
-        write_rays(w, r.shadow.iter().map(|s| &s.ray))
-    })?;
+    rays("shadow_rays.csv", &mut r.shadow.iter().map(|s| &s.ray))?;
     let hits = Answers::Any(r.shadow.iter().map(|s| s.occluded).collect());
-    write("shadow_hits.csv", &|w| hits.write_csv(w))
+    write_answers(&dir.join("shadow_hits.csv"), &hits)
 }
 
 /// The human summary: what was rendered, rays per second of each kind, the shadow replay.

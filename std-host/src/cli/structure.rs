@@ -16,9 +16,10 @@ use rdbvh_core::toplevel::{
     DEFAULT_OCTREE_LEVELS,
 };
 
+use super::answers::{write_answers, Answers};
 use super::areas::load_areas;
 use super::rays::read_rays;
-use super::trace::{write_answers, Answers, LookupKind, TraceArgs};
+use super::trace::{check_outputs, LookupKind, TraceArgs};
 use super::{load_scene, CliError};
 use crate::parallel::build_scene;
 
@@ -175,6 +176,7 @@ pub fn structure_options(args: &TraceArgs) -> SceneOptions {
 
 /// Runs `rdbvh trace --areas ...`; the summary goes to `log`.
 pub fn run(args: &TraceArgs, areas_path: &Path, log: &mut impl Write) -> Result<(), CliError> {
+    check_outputs(args)?;
     if args.builder.builder.is_some() {
         return Err(CliError::Usage(
             "--builder chooses the single BVH of a trace without --areas; with --areas, choose \

@@ -2,20 +2,20 @@
 //! with one BVH over the scene or (with `--areas`) through the scene structure of influence
 //! areas, local BVHs and a fallback BVH.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::{value_parser, Args, ValueEnum};
 use rayon::prelude::*;
-use rdbvh_core::bvh::{Hit, Traversable, WideBvh};
+use rdbvh_core::bvh::{Traversable, WideBvh};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::toplevel::MAX_OCTREE_LEVELS;
 
+use super::answers::{write_answers, Answers};
 use super::builder::BuilderArgs;
 use super::rays::read_rays;
-use super::{load_scene, structure, CliError};
+use super::{load_scene, CliError};
 
 /// How the scene structure finds the areas that may contain a ray's origin.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -63,73 +63,6 @@ pub struct TraceArgs {
     pub max_tries: u32,
 }
 
-/// The answers of one batch, in ray order.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Answers {
-    /// Closest hit per ray.
-    Closest(Vec<Option<Hit>>),
-    /// Any hit per ray.
-    Any(Vec<bool>),
-}
-
-impl Answers {
-    /// How many rays hit something.
-    pub fn hits(&self) -> usize {
-        match self {
-            Answers::Closest(h) => h.iter().filter(|h| h.is_some()).count(),
-            Answers::Any(h) => h.iter().filter(|&&h| h).count(),
-        }
-    }
-
-    /// Writes the answers as CSV. Floats use Rust's shortest round-trip formatting, so reading
-    /// them back as `f32` gives the same bits, except that a negative zero (a barycentric on an
-    /// edge, rounded from the wrong side) is written `0`, not `-0`.
-    pub fn write_csv(&self, out: &mut impl Write) -> std::io::Result<()> {
-        match self {
-            Answers::Closest(hits) => {
-                writeln!(out, "ray,t,triangle,u,v")?;
-                // Shortest float formatting is most of writing a large batch: rows are formatted
-                // in chunks on every thread, a bounded group at a time, and written in order.
-                let group = WRITE_CHUNK * rayon::current_num_threads().max(1);
-                for (g, rows) in hits.chunks(group).enumerate() {
-                    let texts = rows
-                        .par_chunks(WRITE_CHUNK)
-                        .enumerate()
-                        .map(|(c, chunk)| {
-                            let first = g * group + c * WRITE_CHUNK;
-                            let mut text = Vec::with_capacity(chunk.len() * 40);
-                            for (i, hit) in (first..).zip(chunk) {
-                                match hit {
-                                    Some(h) => {
-                                        // `x + 0.0` is `x` for every float but -0, which becomes +0.
-                                        let (t, u, v) = (h.t + 0.0, h.u + 0.0, h.v + 0.0);
-                                        writeln!(text, "{i},{t},{},{u},{v}", h.triangle)?
-                                    }
-                                    None => writeln!(text, "{i},,,,")?,
-                                }
-                            }
-                            Ok(text)
-                        })
-                        .collect::<std::io::Result<Vec<Vec<u8>>>>()?;
-                    for text in texts {
-                        out.write_all(&text)?;
-                    }
-                }
-            }
-            Answers::Any(hits) => {
-                writeln!(out, "ray,hit")?;
-                for (i, &hit) in hits.iter().enumerate() {
-                    writeln!(out, "{i},{}", u8::from(hit))?;
-                }
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Rows of closest-hit answers formatted by one task of [`Answers::write_csv`].
-const WRITE_CHUNK: usize = 1 << 15;
-
 /// Traces every ray in parallel through `tree` (binary or 4-wide); the answers keep the rays'
 /// order.
 pub fn trace<T: Traversable + Sync>(
@@ -153,17 +86,21 @@ pub fn trace<T: Traversable + Sync>(
     }
 }
 
-/// Runs `rdbvh trace`; the summary goes to `log` (standard error), so standard output stays free.
-pub fn run(args: &TraceArgs, log: &mut impl Write) -> Result<(), CliError> {
+/// Fails before any work when `--out` cannot be written or is one of the command's inputs.
+pub(super) fn check_outputs(args: &TraceArgs) -> Result<(), CliError> {
     let inputs = [Path::new(&args.scene), args.rays.as_path()];
     let areas = args.areas.as_deref().into_iter();
     super::check_output(
         &args.out,
         &inputs.into_iter().chain(areas).collect::<Vec<_>>(),
-    )?;
-    if let Some(areas) = &args.areas {
-        return structure::run(args, areas, log);
-    }
+    )
+}
+
+/// Runs `rdbvh trace` without `--areas` (with them, [`super::structure::run`] does): one BVH over
+/// the scene, traced as its 4-wide collapse. The summary goes to `log` (standard error), so
+/// standard output stays free.
+pub fn run(args: &TraceArgs, log: &mut impl Write) -> Result<(), CliError> {
+    check_outputs(args)?;
     args.builder.check_area(false)?;
     let (scene, _) = load_scene(&args.scene, Some(&args.out))?;
     let rays = read_rays(&args.rays)?;
@@ -199,17 +136,6 @@ pub fn run(args: &TraceArgs, log: &mut impl Write) -> Result<(), CliError> {
     .map_err(CliError::Stdout)
 }
 
-/// Writes `answers` to the CSV file at `path`.
-pub(super) fn write_answers(path: &Path, answers: &Answers) -> Result<(), CliError> {
-    let error = |source| CliError::Write {
-        path: path.to_path_buf(),
-        source,
-    };
-    let mut out = BufWriter::new(File::create(path).map_err(error)?);
-    answers.write_csv(&mut out).map_err(error)?;
-    out.flush().map_err(error)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -229,67 +155,6 @@ mod tests {
         let help = arg.get_help().unwrap().to_string();
         let default = rdbvh_core::toplevel::DEFAULT_OCTREE_LEVELS;
         assert!(help.contains(&format!("[default: {default}]")), "{help}");
-    }
-
-    #[test]
-    fn csv_layout() {
-        let hit = Hit {
-            t: 0.1,
-            triangle: 3,
-            u: 0.25,
-            v: 1e-8,
-        };
-        let mut out = Vec::new();
-        Answers::Closest(vec![Some(hit), None])
-            .write_csv(&mut out)
-            .unwrap();
-        let text = String::from_utf8(out).unwrap();
-        assert_eq!(text, "ray,t,triangle,u,v\n0,0.1,3,0.25,0.00000001\n1,,,,\n");
-        let line = text.lines().nth(1).unwrap();
-        let v: f32 = line.rsplit(',').next().unwrap().parse().unwrap();
-        assert_eq!(v, 1e-8);
-        // A barycentric rounded to -0 on an edge is written 0.
-        let edge = Hit { u: -0.0, ..hit };
-        let mut out = Vec::new();
-        Answers::Closest(vec![Some(edge)])
-            .write_csv(&mut out)
-            .unwrap();
-        assert!(String::from_utf8(out)
-            .unwrap()
-            .ends_with("\n0,0.1,3,0,0.00000001\n"));
-
-        let mut out = Vec::new();
-        Answers::Any(vec![false, true]).write_csv(&mut out).unwrap();
-        assert_eq!(String::from_utf8(out).unwrap(), "ray,hit\n0,0\n1,1\n");
-    }
-
-    #[test]
-    fn answers_past_one_chunk_keep_their_rows_in_order() {
-        // More rows than one group of chunks: each row names its ray, in order.
-        let n = 3 * WRITE_CHUNK * rayon::current_num_threads().max(1) + 17;
-        let hits = (0..n)
-            .map(|i| {
-                (i % 3 != 0).then_some(Hit {
-                    t: i as f32,
-                    triangle: i as u32,
-                    u: 0.5,
-                    v: 0.25,
-                })
-            })
-            .collect();
-        let mut out = Vec::new();
-        Answers::Closest(hits).write_csv(&mut out).unwrap();
-        let text = String::from_utf8(out).unwrap();
-        let rows: Vec<&str> = text.lines().skip(1).collect();
-        assert_eq!(rows.len(), n);
-        for (i, row) in rows.iter().enumerate() {
-            let expect = if i % 3 == 0 {
-                format!("{i},,,,")
-            } else {
-                format!("{i},{},{i},0.5,0.25", i as f32)
-            };
-            assert_eq!(*row, expect);
-        }
     }
 
     #[test]

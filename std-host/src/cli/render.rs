@@ -44,7 +44,7 @@ pub struct RenderArgs {
     /// The scene: an OBJ file (with its MTL), or builtin:NAME for a built-in scene.
     #[arg(value_name = "SCENE.obj")]
     pub scene: String,
-    /// Point, spot and quad lights (TOML, one [[light]] table each), added to the scene's
+    /// Point, spot and quad lights (TOML, one `[[light]]` table each), added to the scene's
     /// emissive triangles.
     #[arg(long, value_name = "LIGHTS.toml")]
     pub lights: Option<PathBuf>,

@@ -59,7 +59,8 @@ fn every_library_agrees_with_rdbvh_on_both_trees() {
     let scene = rdbvh::scene::Scene::open("builtin:random1000").unwrap();
     let report = rdbvh_benches::compare::run("builtin:random1000", &scene.triangles, &quick())
         .expect("runs");
-    assert_eq!(report.runs.len(), 6);
+    // obvhs is measured as two adapters.
+    assert_eq!(report.runs.len(), LIBRARIES.len() + 1);
     for r in &report.runs {
         for g in r.agreement.iter().chain(&r.agreement_mt) {
             assert!(g.rays > 0);
@@ -107,4 +108,68 @@ fn bad_input_is_one_error_line() {
         assert!(!err.contains("panicked"), "{a:?}: {err}");
     }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The C++ adapters (feature `cpp-peers`; CI builds without it, so only a machine with Embree
+/// installed runs this) against brute force: every triangle tested per ray with rdbvh's
+/// double-sided test, on all three ray sets, before the comparison's own agreement check with
+/// rdbvh is asserted for both of their trees.
+#[cfg(feature = "cpp-peers")]
+#[test]
+fn cpp_peers_agree_with_brute_force_and_rdbvh() {
+    use rdbvh_benches::peers::{Embree, Library, Prepared};
+    use rdbvh_benches::{agreement, bounds, ray_set, Answers, RayKind};
+
+    rdbvh_benches::peers::embree::available().expect("Embree 3 is installed");
+    let scene = rdbvh::scene::Scene::open("builtin:random1000").unwrap();
+    let tris = &scene.triangles;
+    let b = bounds(tris);
+    let embree = Prepared::<Embree>::new(tris);
+    for kind in [RayKind::Camera, RayKind::Random, RayKind::Shadow] {
+        let rays = ray_set(tris, &b, kind);
+        assert!(rays.len() > 1000, "{}: {} rays", kind.name(), rays.len());
+        let brute = Answers {
+            closest: rays
+                .iter()
+                .map(|r| {
+                    tris.iter().fold(None::<f32>, |best, t| {
+                        t.intersect(r, best.unwrap_or(r.t_max))
+                            .map(|h| h.t)
+                            .or(best)
+                    })
+                })
+                .collect(),
+            any: rays
+                .iter()
+                .map(|r| tris.iter().any(|t| t.intersect(r, r.t_max).is_some()))
+                .collect(),
+        };
+        let hits = brute.any.iter().filter(|&&h| h).count();
+        assert!(
+            hits > rays.len() / 20 && hits < rays.len(),
+            "{}: {hits} hits",
+            kind.name()
+        );
+        let g = agreement(&brute, &embree.answers(&Embree::rays(&rays)));
+        assert!(
+            g.closest >= MIN_AGREEMENT && g.any >= MIN_AGREEMENT,
+            "{} {}: {g:?}",
+            Embree::NAME,
+            kind.name()
+        );
+    }
+    let report = rdbvh_benches::compare::run("builtin:random1000", tris, &quick()).expect("runs");
+    for name in ["embree"] {
+        let r = report
+            .runs
+            .iter()
+            .find(|r| r.name == name)
+            .unwrap_or_else(|| panic!("{name} measured"));
+        for g in r.agreement.iter().chain(&r.agreement_mt) {
+            assert!(
+                g.rays > 0 && g.closest >= MIN_AGREEMENT && g.any >= MIN_AGREEMENT,
+                "{name}: {g:?}"
+            );
+        }
+    }
 }

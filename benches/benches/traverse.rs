@@ -101,6 +101,16 @@ fn traversals(c: &mut Criterion<Clock>) {
             }
             Subject::<rdbvh_benches::peers::Embree>::new(name, &tris, &sets)
         };
+        #[cfg(feature = "cpp-peers")]
+        let (tiny8, tiny4) = {
+            if let Err(e) = rdbvh_benches::peers::tinybvh::available() {
+                panic!("the cpp-peers feature's tinybvh does not match its adapter: {e}");
+            }
+            (
+                Subject::<rdbvh_benches::peers::TinybvhBvh8>::new(name, &tris, &sets),
+                Subject::<rdbvh_benches::peers::TinybvhBvh4>::new(name, &tris, &sets),
+            )
+        };
         for (query, any) in [("closest", false), ("any", true)] {
             for (kind, rays, _) in &sets {
                 // Shadow segments are any-hit queries only, as renderers trace them.
@@ -122,7 +132,11 @@ fn traversals(c: &mut Criterion<Clock>) {
                 bvh.bench(&mut group, *kind, any);
                 parry.bench(&mut group, *kind, any);
                 #[cfg(feature = "cpp-peers")]
-                embree.bench(&mut group, *kind, any);
+                {
+                    embree.bench(&mut group, *kind, any);
+                    tiny8.bench(&mut group, *kind, any);
+                    tiny4.bench(&mut group, *kind, any);
+                }
                 group.finish();
             }
         }

@@ -44,7 +44,15 @@ use crate::{
 pub const LIBRARIES: &[&str] = &["rdbvh", "rdbvh-wide", "obvhs", "bvh", "parry3d"];
 /// The library names of the JSON output, in output order: with the C++ peers.
 #[cfg(feature = "cpp-peers")]
-pub const LIBRARIES: &[&str] = &["rdbvh", "rdbvh-wide", "obvhs", "bvh", "parry3d", "embree"];
+pub const LIBRARIES: &[&str] = &[
+    "rdbvh",
+    "rdbvh-wide",
+    "obvhs",
+    "bvh",
+    "parry3d",
+    "embree",
+    "tinybvh",
+];
 
 /// What is measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -552,9 +560,20 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
     let mut bvh = check::<BvhCrate>(tris, &sets, &one, &all)?;
     let mut parry = check::<Parry>(tris, &sets, &one, &all)?;
     #[cfg(feature = "cpp-peers")]
-    let mut cpp = {
+    let (mut embree, mut tiny8, mut tiny4) = {
         crate::peers::embree::available()?;
-        check::<crate::peers::Embree>(tris, &sets, &one, &all)?
+        crate::peers::tinybvh::available()?;
+        if u32::try_from(3 * tris.len()).is_err() {
+            return Err(format!(
+                "{scene}: {} triangles is more than tinybvh's 32-bit vertex count holds",
+                tris.len()
+            ));
+        }
+        (
+            check::<crate::peers::Embree>(tris, &sets, &one, &all)?,
+            check::<crate::peers::TinybvhBvh8>(tris, &sets, &one, &all)?,
+            check::<crate::peers::TinybvhBvh4>(tris, &sets, &one, &all)?,
+        )
     };
     let mut top = SerialTop::new(tris, all.current_num_threads());
     let mut pah_reps = if opts.pah {
@@ -566,7 +585,11 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         &mut rdbvh, &mut wide, &mut bvh2, &mut cwbvh, &mut bvh, &mut parry, &mut top,
     ];
     #[cfg(feature = "cpp-peers")]
-    entries.push(&mut cpp);
+    entries.extend([
+        &mut embree as &mut dyn Reps,
+        &mut tiny8 as &mut dyn Reps,
+        &mut tiny4 as &mut dyn Reps,
+    ]);
     // The C++ peers come after the serial top, so the PAH builds are always last.
     let cpp_entries = entries.len() - 7;
     if let Some(p) = pah_reps.as_mut() {
@@ -583,7 +606,7 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         parry.run(&t[5]),
     ];
     #[cfg(feature = "cpp-peers")]
-    runs.push(cpp.run(&t[7]));
+    runs.extend([embree.run(&t[7]), tiny8.run(&t[8]), tiny4.run(&t[9])]);
     let serial_top = (t[6][0], t[6][1]);
     let pah = t.get(7 + cpp_entries).map(|p| PahBuilds {
         sah: p[0],
@@ -694,21 +717,26 @@ fn fold_rows(runs: &[LibraryRun], tris: usize, rays: [usize; 3], clock: Clock) -
         rate(count, &run.timings[i], m, clock)
     };
     let find = |name: &str| runs.iter().find(|r| r.name == name).expect("measured");
+    // The faster of two adapters of one library; `first_builds`: builds are the first's.
+    let faster = |first: &str, second: &str, m: Measure, first_builds: bool| {
+        let (x, y) = (find(first), find(second));
+        let (a, b) = (value(x, m), value(y, m));
+        if (first_builds && m.is_build()) || a >= b {
+            (x.name, a)
+        } else {
+            (y.name, b)
+        }
+    };
     let mut rows = Vec::new();
     for &library in LIBRARIES {
         for m in Measure::ALL {
-            let (source, v) = if library == "obvhs" {
-                let bvh2 = find("obvhs-bvh2");
-                let cw = find("obvhs-cwbvh");
-                let (a, b) = (value(bvh2, m), value(cw, m));
-                if m.is_build() || a >= b {
-                    (bvh2.name, a)
-                } else {
-                    (cw.name, b)
+            let (source, v) = match library {
+                "obvhs" => faster("obvhs-bvh2", "obvhs-cwbvh", m, true),
+                "tinybvh" => faster("tinybvh-bvh8", "tinybvh-bvh4", m, false),
+                _ => {
+                    let r = find(library);
+                    (r.name, value(r, m))
                 }
-            } else {
-                let r = find(library);
-                (r.name, value(r, m))
             };
             rows.push(Row {
                 library,
@@ -827,6 +855,20 @@ impl Report {
              its faster tree: {}",
             obvhs.join(", ")
         );
+        let tinybvh: Vec<String> = self
+            .rows
+            .iter()
+            .filter(|r| r.library == "tinybvh")
+            .map(|r| format!("{} {}", r.measure.name(), r.source))
+            .collect();
+        if !tinybvh.is_empty() {
+            let _ = writeln!(
+                w,
+                "tinybvh: its default Build (binned SAH) into BVH8_CPU or BVH4_CPU, each measure \
+                 the faster layout: {}",
+                tinybvh.join(", ")
+            );
+        }
         for r in &self.runs {
             let _ = writeln!(
                 w,

@@ -29,7 +29,7 @@
 //!   `TriMesh::cast_local_ray` takes. Any hit uses `Bvh::traverse` with an early exit on the
 //!   first triangle hit, since parry's composite any-hit query is a full closest-hit cast.
 //!   Segments end at the ray's `t_max` (parry's `max_time_of_impact`).
-//! - **Embree 3** (feature `cpp-peers`): see [`embree`].
+//! - **Embree 3** and **tinybvh 1.6.8** (feature `cpp-peers`): see `embree` and `tinybvh`.
 
 use glam::{Vec3, Vec3A};
 use rdbvh_core::build::{reinsert, Builder, ReinsertConfig};
@@ -42,6 +42,10 @@ use crate::Answers;
 pub mod embree;
 #[cfg(feature = "cpp-peers")]
 pub use embree::Embree;
+#[cfg(feature = "cpp-peers")]
+pub mod tinybvh;
+#[cfg(feature = "cpp-peers")]
+pub use tinybvh::{TinybvhBvh4, TinybvhBvh8};
 
 /// A library under test: how it takes triangles and rays, builds, and answers the two queries.
 pub trait Library {

@@ -59,8 +59,9 @@ fn every_library_agrees_with_rdbvh_on_both_trees() {
     let scene = rdbvh::scene::Scene::open("builtin:random1000").unwrap();
     let report = rdbvh_benches::compare::run("builtin:random1000", &scene.triangles, &quick())
         .expect("runs");
-    // obvhs is measured as two adapters.
-    assert_eq!(report.runs.len(), LIBRARIES.len() + 1);
+    // obvhs (and tinybvh, with the C++ peers) are measured as two adapters each.
+    let two_adapters = if cfg!(feature = "cpp-peers") { 2 } else { 1 };
+    assert_eq!(report.runs.len(), LIBRARIES.len() + two_adapters);
     for r in &report.runs {
         for g in r.agreement.iter().chain(&r.agreement_mt) {
             assert!(g.rays > 0);
@@ -117,14 +118,28 @@ fn bad_input_is_one_error_line() {
 #[cfg(feature = "cpp-peers")]
 #[test]
 fn cpp_peers_agree_with_brute_force_and_rdbvh() {
-    use rdbvh_benches::peers::{Embree, Library, Prepared};
+    use rdbvh_benches::peers::{Embree, Library, Prepared, TinybvhBvh4, TinybvhBvh8};
     use rdbvh_benches::{agreement, bounds, ray_set, Answers, RayKind};
 
     rdbvh_benches::peers::embree::available().expect("Embree 3 is installed");
+    rdbvh_benches::peers::tinybvh::available().expect("tinybvh matches its adapter");
     let scene = rdbvh::scene::Scene::open("builtin:random1000").unwrap();
     let tris = &scene.triangles;
     let b = bounds(tris);
-    let embree = Prepared::<Embree>::new(tris);
+    fn check<L: Library>(
+        tris: &[rdbvh_core::geometry::Triangle],
+        rays: &[rdbvh_core::geometry::Ray],
+        brute: &Answers,
+        kind: RayKind,
+    ) {
+        let g = agreement(brute, &Prepared::<L>::new(tris).answers(&L::rays(rays)));
+        assert!(
+            g.closest >= MIN_AGREEMENT && g.any >= MIN_AGREEMENT,
+            "{} {}: {g:?}",
+            L::NAME,
+            kind.name()
+        );
+    }
     for kind in [RayKind::Camera, RayKind::Random, RayKind::Shadow] {
         let rays = ray_set(tris, &b, kind);
         assert!(rays.len() > 1000, "{}: {} rays", kind.name(), rays.len());
@@ -150,16 +165,12 @@ fn cpp_peers_agree_with_brute_force_and_rdbvh() {
             "{}: {hits} hits",
             kind.name()
         );
-        let g = agreement(&brute, &embree.answers(&Embree::rays(&rays)));
-        assert!(
-            g.closest >= MIN_AGREEMENT && g.any >= MIN_AGREEMENT,
-            "{} {}: {g:?}",
-            Embree::NAME,
-            kind.name()
-        );
+        check::<Embree>(tris, &rays, &brute, kind);
+        check::<TinybvhBvh8>(tris, &rays, &brute, kind);
+        check::<TinybvhBvh4>(tris, &rays, &brute, kind);
     }
     let report = rdbvh_benches::compare::run("builtin:random1000", tris, &quick()).expect("runs");
-    for name in ["embree"] {
+    for name in ["embree", "tinybvh-bvh8", "tinybvh-bvh4"] {
         let r = report
             .runs
             .iter()

@@ -50,7 +50,7 @@ const FAR: f32 = 1e30;
 #[derive(Clone, Copy)]
 struct RayBlob([u8; 128]);
 
-/// Whether the compiled tinybvh matches this adapter: its ray fits [`RayBlob`], and the scene
+/// Whether the compiled tinybvh matches this adapter: its ray fits the adapter's 128-byte copy, and the scene
 /// size fits its 32-bit triangle count (checked per scene in `compare::run`).
 pub fn available() -> Result<(), String> {
     // SAFETY: plain functions without arguments.

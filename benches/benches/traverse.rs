@@ -1,5 +1,6 @@
-//! Closest-hit and any-hit traversal of camera rays and random rays on the bunny and Crytek
-//! Sponza: rdbvh beside the peers, on the same triangles and the same rays, throughput in rays.
+//! Closest-hit and any-hit traversal of camera rays and random rays, and any hit of shadow
+//! segments, on the bunny and Crytek Sponza: rdbvh beside the peers (with the C++ ones under the
+//! `cpp-peers` feature), on the same triangles and the same rays, throughput in rays.
 //!
 //! Before anything is timed, every library's answers are compared with rdbvh's, ray by ray, and
 //! the run stops if any library agrees on fewer than [`MIN_AGREEMENT`] of the rays: a speed
@@ -78,22 +79,44 @@ fn traversals(c: &mut Criterion<Clock>) {
         };
         let b = bounds(&tris);
         let reference = Prepared::<Rdbvh>::new(&tris);
-        let sets: Vec<(RayKind, Vec<Ray>, Answers)> = [RayKind::Camera, RayKind::Random]
-            .into_iter()
-            .map(|kind| {
-                let rays = ray_set(&b, kind);
-                let answers = reference.answers(&rays);
-                (kind, rays, answers)
-            })
-            .collect();
+        let sets: Vec<(RayKind, Vec<Ray>, Answers)> =
+            [RayKind::Camera, RayKind::Random, RayKind::Shadow]
+                .into_iter()
+                .map(|kind| {
+                    let rays = ray_set(&tris, &b, kind);
+                    let answers = reference.answers(&rays);
+                    (kind, rays, answers)
+                })
+                .collect();
         let rdbvh = Subject::<Rdbvh>::new(name, &tris, &sets);
         let wide = Subject::<RdbvhWide>::new(name, &tris, &sets);
         let obvhs2 = Subject::<ObvhsBvh2>::new(name, &tris, &sets);
         let obvhs8 = Subject::<ObvhsCwbvh>::new(name, &tris, &sets);
         let bvh = Subject::<BvhCrate>::new(name, &tris, &sets);
         let parry = Subject::<Parry>::new(name, &tris, &sets);
+        #[cfg(feature = "cpp-peers")]
+        let embree = {
+            if let Err(e) = rdbvh_benches::peers::embree::available() {
+                panic!("the cpp-peers feature needs a working Embree 3: {e}");
+            }
+            Subject::<rdbvh_benches::peers::Embree>::new(name, &tris, &sets)
+        };
+        #[cfg(feature = "cpp-peers")]
+        let (tiny8, tiny4) = {
+            if let Err(e) = rdbvh_benches::peers::tinybvh::available() {
+                panic!("the cpp-peers feature's tinybvh does not match its adapter: {e}");
+            }
+            (
+                Subject::<rdbvh_benches::peers::TinybvhBvh8>::new(name, &tris, &sets),
+                Subject::<rdbvh_benches::peers::TinybvhBvh4>::new(name, &tris, &sets),
+            )
+        };
         for (query, any) in [("closest", false), ("any", true)] {
             for (kind, rays, _) in &sets {
+                // Shadow segments are any-hit queries only, as renderers trace them.
+                if *kind == RayKind::Shadow && !any {
+                    continue;
+                }
                 let mut group =
                     c.benchmark_group(format!("traverse/{name}/{query}-{}", kind.name()));
                 group
@@ -108,6 +131,12 @@ fn traversals(c: &mut Criterion<Clock>) {
                 obvhs8.bench(&mut group, *kind, any);
                 bvh.bench(&mut group, *kind, any);
                 parry.bench(&mut group, *kind, any);
+                #[cfg(feature = "cpp-peers")]
+                {
+                    embree.bench(&mut group, *kind, any);
+                    tiny8.bench(&mut group, *kind, any);
+                    tiny4.bench(&mut group, *kind, any);
+                }
                 group.finish();
             }
         }

@@ -55,7 +55,7 @@ fn main() {
         println!("{name}: {} triangles", tris.len());
         let b = bounds(&tris);
         for kind in [RayKind::Camera, RayKind::Random] {
-            let rays = ray_set(&b, kind);
+            let rays = ray_set(&tris, &b, kind);
             let reference = Prepared::<Rdbvh>::new(&tris).answers(&rays);
             report::<Rdbvh>(&tris, &rays, &reference, kind);
             report::<RdbvhWide>(&tris, &rays, &reference, kind);

@@ -50,7 +50,7 @@ fn main() {
     };
     let secs = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(5.0);
     let tris = &scene.triangles;
-    let rays = ray_set(&bounds(tris), kind);
+    let rays = ray_set(tris, &bounds(tris), kind);
     match args[1].as_str() {
         "rdbvh" => spin::<Rdbvh>(tris, &rays, secs),
         "rdbvh-wide" => spin::<RdbvhWide>(tris, &rays, secs),

@@ -175,7 +175,7 @@ fn run(scene: &str, for_wide: bool, configs: &[(f32, u32)]) -> Result<(), String
     }
 
     for kind in [RayKind::Camera, RayKind::Random] {
-        let rays = ray_set(&b, kind);
+        let rays = ray_set(&tris, &b, kind);
         let mut best = vec![0.0f64; wides.len()];
         let (_, reference) = trace(&wides[0], &rays);
         for _ in 0..5 {

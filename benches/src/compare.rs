@@ -1,7 +1,9 @@
 //! The peer comparison behind the `peers` binary: one scene, the same triangles and the same rays
-//! for rdbvh (binary and 4-wide), obvhs 0.4, bvh 0.13 and parry3d 0.31; single-threaded and
-//! threaded builds, closest hit on camera and random rays, any hit on random rays; every
-//! library's answers checked against rdbvh's before any number is reported.
+//! for rdbvh (binary and 4-wide), obvhs 0.4, bvh 0.13 and parry3d 0.31, and with the `cpp-peers`
+//! feature Embree 3; single-threaded and threaded builds, closest hit on camera and random rays,
+//! any hit on random rays and on shadow segments ([`crate::shadow_rays`]); every library's
+//! answers (closest and any hit, on all three ray sets, for the trees of both of its builds)
+//! checked against rdbvh's before any number is reported.
 //!
 //! **Clocks.** Single-threaded measurements (`build_1t` and the traversals) report the best
 //! repetition's CPU time of the thread that ran them (`CLOCK_THREAD_CPUTIME_ID`), because the
@@ -38,7 +40,19 @@ use crate::{
 };
 
 /// The library names of the JSON output, in output order.
-pub const LIBRARIES: [&str; 5] = ["rdbvh", "rdbvh-wide", "obvhs", "bvh", "parry3d"];
+#[cfg(not(feature = "cpp-peers"))]
+pub const LIBRARIES: &[&str] = &["rdbvh", "rdbvh-wide", "obvhs", "bvh", "parry3d"];
+/// The library names of the JSON output, in output order: with the C++ peers.
+#[cfg(feature = "cpp-peers")]
+pub const LIBRARIES: &[&str] = &[
+    "rdbvh",
+    "rdbvh-wide",
+    "obvhs",
+    "bvh",
+    "parry3d",
+    "embree",
+    "tinybvh",
+];
 
 /// What is measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -53,16 +67,19 @@ pub enum Measure {
     ClosestRandom,
     /// Any hit of the random rays.
     AnyRandom,
+    /// Any hit of the shadow segments ([`crate::shadow_rays`]).
+    AnyShadow,
 }
 
 impl Measure {
     /// Every measure, in output order.
-    pub const ALL: [Measure; 5] = [
+    pub const ALL: [Measure; 6] = [
         Measure::Build1t,
         Measure::BuildMt,
         Measure::ClosestCamera,
         Measure::ClosestRandom,
         Measure::AnyRandom,
+        Measure::AnyShadow,
     ];
 
     /// The name in the JSON output.
@@ -73,6 +90,7 @@ impl Measure {
             Measure::ClosestCamera => "closest_camera",
             Measure::ClosestRandom => "closest_random",
             Measure::AnyRandom => "any_random",
+            Measure::AnyShadow => "any_shadow",
         }
     }
 
@@ -217,11 +235,11 @@ pub struct LibraryRun {
     /// Its threaded build, or `None` when `build_mt` is its one-thread build.
     pub parallel_build: Option<&'static str>,
     /// Timings per measure, in [`Measure::ALL`] order.
-    pub timings: [Timing; 5],
-    /// Agreement with rdbvh on the camera and random rays, tree of the one-thread build.
-    pub agreement: [Agreement; 2],
-    /// Agreement with rdbvh on the camera and random rays, tree of the threaded build.
-    pub agreement_mt: [Agreement; 2],
+    pub timings: [Timing; 6],
+    /// Agreement with rdbvh on the camera, random and shadow rays, tree of the one-thread build.
+    pub agreement: [Agreement; 3],
+    /// Agreement with rdbvh on the camera, random and shadow rays, tree of the threaded build.
+    pub agreement_mt: [Agreement; 3],
 }
 
 /// One reported number.
@@ -258,12 +276,14 @@ pub struct PahBuilds {
 pub struct Report {
     /// The scene as given.
     pub scene: String,
+    /// The shadow rays' point light ([`crate::shadow_light`]).
+    pub light: Vec3,
     /// Triangles.
     pub triangles: usize,
-    /// Rays per set.
-    pub rays: [usize; 2],
-    /// Share of rays rdbvh finds a hit for, camera and random.
-    pub hit_share: [f64; 2],
+    /// Rays per set: camera, random, shadow.
+    pub rays: [usize; 3],
+    /// Share of rays rdbvh finds a hit for, camera, random and shadow.
+    pub hit_share: [f64; 3],
     /// Threads of the threaded builds.
     pub threads: usize,
     /// The clock of single-threaded numbers.
@@ -297,8 +317,9 @@ struct Contender<L: Library> {
     prepared: Prepared<L>,
     camera: Vec<L::Ray>,
     random: Vec<L::Ray>,
-    agreement: [Agreement; 2],
-    agreement_mt: [Agreement; 2],
+    shadow: Vec<L::Ray>,
+    agreement: [Agreement; 3],
+    agreement_mt: [Agreement; 3],
 }
 
 impl<L: Library> Contender<L> {
@@ -312,7 +333,7 @@ impl<L: Library> Contender<L> {
         LibraryRun {
             name: L::NAME,
             parallel_build: L::PARALLEL_BUILD,
-            timings: [t[0], build_mt, t[2], t[3], t[4]],
+            timings: [t[0], build_mt, t[2], t[3], t[4], t[5]],
             agreement: self.agreement,
             agreement_mt: self.agreement_mt,
         }
@@ -347,6 +368,7 @@ where
             Measure::ClosestCamera => time(|| p.closest_all(std::hint::black_box(&self.camera))),
             Measure::ClosestRandom => time(|| p.closest_all(std::hint::black_box(&self.random))),
             Measure::AnyRandom => time(|| p.any_all(std::hint::black_box(&self.random))),
+            Measure::AnyShadow => time(|| p.any_all(std::hint::black_box(&self.shadow))),
         })
     }
 }
@@ -363,12 +385,12 @@ where
     L::Scene: Send,
     L::Accel: Send,
 {
-    let agree = |prepared: &Prepared<L>, which: &str| -> Result<[Agreement; 2], String> {
+    let agree = |prepared: &Prepared<L>, which: &str| -> Result<[Agreement; 3], String> {
         let mut out = [Agreement {
             rays: 0,
             closest: 1.0,
             any: 1.0,
-        }; 2];
+        }; 3];
         for (slot, (kind, rays, reference)) in out.iter_mut().zip(sets) {
             let g = agreement(reference, &prepared.answers(&L::rays(rays)));
             if g.closest < MIN_AGREEMENT || g.any < MIN_AGREEMENT {
@@ -404,6 +426,7 @@ where
         prepared,
         camera: native(RayKind::Camera),
         random: native(RayKind::Random),
+        shadow: native(RayKind::Shadow),
         agreement: agreement_1t,
         agreement_mt,
     })
@@ -516,14 +539,15 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         .map_err(|e| format!("cannot start the rayon pool: {e}"))?;
     let b = bounds(tris);
     let reference = Prepared::<Rdbvh>::new(tris);
-    let sets: Vec<(RayKind, Vec<Ray>, Answers)> = [RayKind::Camera, RayKind::Random]
-        .into_iter()
-        .map(|kind| {
-            let rays = ray_set(&b, kind);
-            let answers = reference.answers(&rays);
-            (kind, rays, answers)
-        })
-        .collect();
+    let sets: Vec<(RayKind, Vec<Ray>, Answers)> =
+        [RayKind::Camera, RayKind::Random, RayKind::Shadow]
+            .into_iter()
+            .map(|kind| {
+                let rays = ray_set(tris, &b, kind);
+                let answers = reference.answers(&rays);
+                (kind, rays, answers)
+            })
+            .collect();
     drop(reference);
     let share = |a: &Answers| {
         a.closest.iter().filter(|t| t.is_some()).count() as f64 / a.closest.len().max(1) as f64
@@ -535,6 +559,22 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
     let mut cwbvh = check::<ObvhsCwbvh>(tris, &sets, &one, &all)?;
     let mut bvh = check::<BvhCrate>(tris, &sets, &one, &all)?;
     let mut parry = check::<Parry>(tris, &sets, &one, &all)?;
+    #[cfg(feature = "cpp-peers")]
+    let (mut embree, mut tiny8, mut tiny4) = {
+        crate::peers::embree::available()?;
+        crate::peers::tinybvh::available()?;
+        if u32::try_from(3 * tris.len()).is_err() {
+            return Err(format!(
+                "{scene}: {} triangles is more than tinybvh's 32-bit vertex count holds",
+                tris.len()
+            ));
+        }
+        (
+            check::<crate::peers::Embree>(tris, &sets, &one, &all)?,
+            check::<crate::peers::TinybvhBvh8>(tris, &sets, &one, &all)?,
+            check::<crate::peers::TinybvhBvh4>(tris, &sets, &one, &all)?,
+        )
+    };
     let mut top = SerialTop::new(tris, all.current_num_threads());
     let mut pah_reps = if opts.pah {
         Some(PahReps::new(tris, &b)?)
@@ -544,11 +584,20 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
     let mut entries: Vec<&mut dyn Reps> = vec![
         &mut rdbvh, &mut wide, &mut bvh2, &mut cwbvh, &mut bvh, &mut parry, &mut top,
     ];
+    #[cfg(feature = "cpp-peers")]
+    entries.extend([
+        &mut embree as &mut dyn Reps,
+        &mut tiny8 as &mut dyn Reps,
+        &mut tiny4 as &mut dyn Reps,
+    ]);
+    // The C++ peers come after the serial top, so the PAH builds are always last.
+    let cpp_entries = entries.len() - 7;
     if let Some(p) = pah_reps.as_mut() {
         entries.push(p);
     }
     let t = interleave(&mut entries, opts, &one, &all);
-    let runs = vec![
+    #[allow(unused_mut)]
+    let mut runs = vec![
         rdbvh.run(&t[0]),
         wide.run(&t[1]),
         bvh2.run(&t[2]),
@@ -556,8 +605,10 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         bvh.run(&t[4]),
         parry.run(&t[5]),
     ];
+    #[cfg(feature = "cpp-peers")]
+    runs.extend([embree.run(&t[7]), tiny8.run(&t[8]), tiny4.run(&t[9])]);
     let serial_top = (t[6][0], t[6][1]);
-    let pah = t.get(7).map(|p| PahBuilds {
+    let pah = t.get(7 + cpp_entries).map(|p| PahBuilds {
         sah: p[0],
         full_plane: p[1],
         full_point: p[2],
@@ -565,12 +616,14 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         pah_point: p[4],
     });
     let n = tris.len();
-    let rows = fold_rows(&runs, n, sets[0].1.len(), sets[1].1.len(), opts.clock);
+    let rays = [sets[0].1.len(), sets[1].1.len(), sets[2].1.len()];
+    let rows = fold_rows(&runs, n, rays, opts.clock);
     Ok(Report {
         scene: scene.to_string(),
+        light: crate::shadow_light(&b),
         triangles: n,
-        rays: [sets[0].1.len(), sets[1].1.len()],
-        hit_share: [share(&sets[0].2), share(&sets[1].2)],
+        rays,
+        hit_share: [share(&sets[0].2), share(&sets[1].2), share(&sets[2].2)],
         threads: all.current_num_threads(),
         clock: opts.clock,
         load: [load_before, load_average()],
@@ -650,13 +703,8 @@ fn rate(count: usize, t: &Timing, measure: Measure, clock: Clock) -> f64 {
 
 /// Folds the adapters into the reported libraries: obvhs's build is its binary tree's, each of
 /// its traversals the faster tree's.
-fn fold_rows(
-    runs: &[LibraryRun],
-    tris: usize,
-    camera: usize,
-    random: usize,
-    clock: Clock,
-) -> Vec<Row> {
+fn fold_rows(runs: &[LibraryRun], tris: usize, rays: [usize; 3], clock: Clock) -> Vec<Row> {
+    let [camera, random, shadow] = rays;
     let value = |run: &LibraryRun, m: Measure| {
         let (i, count) = match m {
             Measure::Build1t => (0, tris),
@@ -664,25 +712,31 @@ fn fold_rows(
             Measure::ClosestCamera => (2, camera),
             Measure::ClosestRandom => (3, random),
             Measure::AnyRandom => (4, random),
+            Measure::AnyShadow => (5, shadow),
         };
         rate(count, &run.timings[i], m, clock)
     };
     let find = |name: &str| runs.iter().find(|r| r.name == name).expect("measured");
+    // The faster of two adapters of one library; `first_builds`: builds are the first's.
+    let faster = |first: &str, second: &str, m: Measure, first_builds: bool| {
+        let (x, y) = (find(first), find(second));
+        let (a, b) = (value(x, m), value(y, m));
+        if (first_builds && m.is_build()) || a >= b {
+            (x.name, a)
+        } else {
+            (y.name, b)
+        }
+    };
     let mut rows = Vec::new();
-    for library in LIBRARIES {
+    for &library in LIBRARIES {
         for m in Measure::ALL {
-            let (source, v) = if library == "obvhs" {
-                let bvh2 = find("obvhs-bvh2");
-                let cw = find("obvhs-cwbvh");
-                let (a, b) = (value(bvh2, m), value(cw, m));
-                if m.is_build() || a >= b {
-                    (bvh2.name, a)
-                } else {
-                    (cw.name, b)
+            let (source, v) = match library {
+                "obvhs" => faster("obvhs-bvh2", "obvhs-cwbvh", m, true),
+                "tinybvh" => faster("tinybvh-bvh8", "tinybvh-bvh4", m, false),
+                _ => {
+                    let r = find(library);
+                    (r.name, value(r, m))
                 }
-            } else {
-                let r = find(library);
-                (r.name, value(r, m))
             };
             rows.push(Row {
                 library,
@@ -732,13 +786,17 @@ impl Report {
         let w = &mut s;
         let _ = writeln!(
             w,
-            "scene {}: {} triangles; {} camera rays ({:.1}% hit), {} random rays ({:.1}% hit)",
+            "scene {}: {} triangles; {} camera rays ({:.1}% hit), {} random rays ({:.1}% hit), \
+             {} shadow rays ({:.1}% occluded) to a light at {:?}",
             self.scene,
             self.triangles,
             self.rays[0],
             100.0 * self.hit_share[0],
             self.rays[1],
-            100.0 * self.hit_share[1]
+            100.0 * self.hit_share[1],
+            self.rays[2],
+            100.0 * self.hit_share[2],
+            self.light.to_array(),
         );
         let _ = writeln!(
             w,
@@ -770,7 +828,7 @@ impl Report {
             let _ = write!(w, " {:>24}", format!("{} {}", m.name(), m.unit()));
         }
         let _ = writeln!(w);
-        for library in LIBRARIES {
+        for &library in LIBRARIES {
             let _ = write!(w, "{library:<11}");
             for m in Measure::ALL {
                 let v = self.value(library, m).unwrap_or(0.0);
@@ -797,6 +855,20 @@ impl Report {
              its faster tree: {}",
             obvhs.join(", ")
         );
+        let tinybvh: Vec<String> = self
+            .rows
+            .iter()
+            .filter(|r| r.library == "tinybvh")
+            .map(|r| format!("{} {}", r.measure.name(), r.source))
+            .collect();
+        if !tinybvh.is_empty() {
+            let _ = writeln!(
+                w,
+                "tinybvh: its default Build (binned SAH) into BVH8_CPU or BVH4_CPU, each measure \
+                 the faster layout: {}",
+                tinybvh.join(", ")
+            );
+        }
         for r in &self.runs {
             let _ = writeln!(
                 w,
@@ -835,12 +907,14 @@ impl Report {
             let cell = |g: &Agreement| format!("{:.4}% / {:.4}%", 100.0 * g.closest, 100.0 * g.any);
             let _ = writeln!(
                 w,
-                "  {:<12} camera {} | {}   random {} | {}",
+                "  {:<12} camera {} | {}   random {} | {}   shadow {} | {}",
                 r.name,
                 cell(&r.agreement[0]),
                 cell(&r.agreement_mt[0]),
                 cell(&r.agreement[1]),
                 cell(&r.agreement_mt[1]),
+                cell(&r.agreement[2]),
+                cell(&r.agreement_mt[2]),
             );
         }
         if let Some(p) = &self.pah {

@@ -121,6 +121,9 @@ pub enum RayKind {
     /// Origins uniform in the scene's box, directions uniform on the sphere: incoherent, like
     /// secondary rays, and they start inside the geometry.
     Random,
+    /// Shadow segments ([`shadow_rays`]): from the camera rays' first hits, lifted off the
+    /// surface, to a point light inside the scene ([`shadow_light`]), ending just short of it.
+    Shadow,
 }
 
 impl RayKind {
@@ -129,6 +132,7 @@ impl RayKind {
         match self {
             RayKind::Camera => "camera",
             RayKind::Random => "random",
+            RayKind::Shadow => "shadow",
         }
     }
 }
@@ -208,12 +212,55 @@ pub fn random_rays(b: &Aabb, n: usize, seed: u64) -> Vec<Ray> {
     rays
 }
 
-/// The ray set of `kind` for a scene with bounds `b`.
-pub fn ray_set(b: &Aabb, kind: RayKind) -> Vec<Ray> {
+/// The ray set of `kind` for the scene `tris` with bounds `b` (the shadow set traces the camera
+/// set first to find the surface points it starts from).
+pub fn ray_set(tris: &[Triangle], b: &Aabb, kind: RayKind) -> Vec<Ray> {
     match kind {
         RayKind::Camera => camera_rays(b, CAMERA_SIDE),
         RayKind::Random => random_rays(b, RANDOM_RAYS, RANDOM_SEED),
+        RayKind::Shadow => shadow_rays(tris, b, &camera_rays(b, CAMERA_SIDE)),
     }
+}
+
+/// Where the shadow rays' point light sits: above the centre of the scene's box by 40% of its
+/// height, so that it is inside the box, below its top, and (in an interior like Sponza) in the
+/// open space of the room rather than in a wall.
+pub fn shadow_light(b: &Aabb) -> Vec3 {
+    b.center() + Vec3::Y * (0.4 * (b.max.y - b.min.y))
+}
+
+/// How far short of the light a shadow segment ends, in units of the segment (`t_max = 1 - this`):
+/// a renderer stops just before the light so that the light's own geometry, if any, does not
+/// shadow it.
+pub const SHADOW_T_GAP: f32 = 1e-4;
+
+/// Shadow segments as a renderer traces them after its primary rays: for each of `camera`'s rays
+/// that hits `tris`, the first hit point, moved off the surface along the triangle's normal (on
+/// the camera's side) by `1e-5` of the box diagonal so that the segment does not hit its own
+/// triangle, to [`shadow_light`]; `dir` is the unnormalised offset to the light and
+/// `t` runs over `[0, 1 - SHADOW_T_GAP]`, the way renderers pass light samples. Points whose surface
+/// faces away from the light are left out, as a renderer skips them (no light arrives).
+pub fn shadow_rays(tris: &[Triangle], b: &Aabb, camera: &[Ray]) -> Vec<Ray> {
+    let bvh = rdbvh_build(tris);
+    let light = shadow_light(b);
+    let lift = 1e-5 * (b.max - b.min).length();
+    camera
+        .iter()
+        .filter_map(|ray| {
+            let hit = bvh.closest_hit(ray, tris)?;
+            let t = &tris[hit.triangle as usize];
+            let mut n = (t.v1 - t.v0).cross(t.v2 - t.v0).normalize_or_zero();
+            if n.dot(ray.dir) > 0.0 {
+                n = -n;
+            }
+            let p = ray.origin + ray.dir * hit.t + n * lift;
+            let to_light = light - p;
+            if n == Vec3::ZERO || n.dot(to_light) <= 0.0 {
+                return None;
+            }
+            Ray::segment(p, to_light, 0.0, 1.0 - SHADOW_T_GAP).ok()
+        })
+        .collect()
 }
 
 /// rdbvh's binned SAH build, single-threaded: allocates its arena and output per build, as the

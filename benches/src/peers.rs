@@ -28,6 +28,8 @@
 //!   `Bvh::cast_ray` with parry's own triangle ray cast per leaf, which is exactly the path
 //!   `TriMesh::cast_local_ray` takes. Any hit uses `Bvh::traverse` with an early exit on the
 //!   first triangle hit, since parry's composite any-hit query is a full closest-hit cast.
+//!   Segments end at the ray's `t_max` (parry's `max_time_of_impact`).
+//! - **Embree 3** and **tinybvh 1.6.8** (feature `cpp-peers`): see `embree` and `tinybvh`.
 
 use glam::{Vec3, Vec3A};
 use rdbvh_core::build::{reinsert, Builder, ReinsertConfig};
@@ -35,6 +37,15 @@ use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::Sah;
 
 use crate::Answers;
+
+#[cfg(feature = "cpp-peers")]
+pub mod embree;
+#[cfg(feature = "cpp-peers")]
+pub use embree::Embree;
+#[cfg(feature = "cpp-peers")]
+pub mod tinybvh;
+#[cfg(feature = "cpp-peers")]
+pub use tinybvh::{TinybvhBvh4, TinybvhBvh8};
 
 /// A library under test: how it takes triangles and rays, builds, and answers the two queries.
 pub trait Library {
@@ -325,11 +336,14 @@ impl bvh::bounding_hierarchy::BHShape<f32, 3> for BvhShape {
 }
 
 /// A ray for the `bvh` adapter: the crate's ray for the tree, rdbvh's for the shared triangle
-/// test (same origin and unit direction, so the same distances).
+/// test (the same origin; `bvh` normalises the direction, see `dir_len`).
 #[derive(Clone, Copy, Debug)]
 pub struct BvhRay {
     tree: bvh::ray::Ray<f32, 3>,
     tri: Ray,
+    /// `|dir|`: `bvh` normalises its rays' directions, so its box distances are this many
+    /// times rdbvh's `t` (1 for the unit camera and random rays, not for shadow segments).
+    dir_len: f32,
 }
 
 /// `bvh` 0.13's binned SAH tree, one triangle per leaf.
@@ -354,6 +368,7 @@ impl Library for BvhCrate {
                     nalgebra::Vector3::new(r.dir.x, r.dir.y, r.dir.z),
                 ),
                 tri: *r,
+                dir_len: r.dir.length(),
             })
             .collect()
     }
@@ -373,7 +388,7 @@ impl Library for BvhCrate {
             // Leaves come out in order of their boxes' entry distance: once one starts beyond
             // the best hit, so do all the rest.
             match ray.tree.intersection_slice_for_aabb(&shape.aabb()) {
-                Some((entry, _)) if entry > best => break,
+                Some((entry, _)) if entry > best * ray.dir_len => break,
                 _ => {}
             }
             if let Some(h) = shape.tri.intersect(&ray.tri, best) {
@@ -400,6 +415,14 @@ pub struct ParryScene {
     boxes: Vec<parry3d::bounding_volume::Aabb>,
 }
 
+/// A ray for the parry3d adapter: parry's ray has no segment end of its own, its queries take
+/// one (`max_time_of_impact`), in units of the same unnormalised direction as rdbvh's `t`.
+#[derive(Clone, Copy, Debug)]
+pub struct ParryRay {
+    ray: parry3d::query::Ray,
+    t_max: f32,
+}
+
 fn pv(v: Vec3) -> parry3d::math::Vector {
     parry3d::math::Vector::new(v.x, v.y, v.z)
 }
@@ -409,7 +432,7 @@ impl Library for Parry {
     /// parry3d 0.31 builds on one thread ("neither strategy is currently parallelized").
     const PARALLEL_BUILD: Option<&'static str> = None;
     type Scene = ParryScene;
-    type Ray = parry3d::query::Ray;
+    type Ray = ParryRay;
     type Accel = parry3d::partitioning::Bvh;
 
     fn scene(tris: &[Triangle]) -> Self::Scene {
@@ -422,7 +445,10 @@ impl Library for Parry {
     }
     fn rays(rays: &[Ray]) -> Vec<Self::Ray> {
         rays.iter()
-            .map(|r| parry3d::query::Ray::new(pv(r.origin), pv(r.dir)))
+            .map(|r| ParryRay {
+                ray: parry3d::query::Ray::new(pv(r.origin), pv(r.dir)),
+                t_max: r.t_max.min(f32::MAX),
+            })
             .collect()
     }
     fn build(scene: &mut Self::Scene) -> Self::Accel {
@@ -441,8 +467,8 @@ impl Library for Parry {
     fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> Option<f32> {
         use parry3d::query::RayCast;
         accel
-            .cast_ray(ray, f32::MAX, |i, best| {
-                scene.tris[i as usize].cast_local_ray(ray, best, true)
+            .cast_ray(&ray.ray, ray.t_max, |i, best| {
+                scene.tris[i as usize].cast_local_ray(&ray.ray, best, true)
             })
             .map(|(_, t)| t)
     }
@@ -452,11 +478,11 @@ impl Library for Parry {
         use parry3d::query::RayCast;
         let mut hit = false;
         accel.traverse(|node| {
-            if node.cast_ray(ray, f32::MAX) == f32::MAX {
+            if node.cast_ray(&ray.ray, ray.t_max) == f32::MAX {
                 return TraversalAction::Prune;
             }
             if let Some(i) = node.leaf_data() {
-                if scene.tris[i as usize].intersects_local_ray(ray, f32::MAX) {
+                if scene.tris[i as usize].intersects_local_ray(&ray.ray, ray.t_max) {
                     hit = true;
                     return TraversalAction::EarlyExit;
                 }

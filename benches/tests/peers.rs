@@ -59,7 +59,9 @@ fn every_library_agrees_with_rdbvh_on_both_trees() {
     let scene = rdbvh::scene::Scene::open("builtin:random1000").unwrap();
     let report = rdbvh_benches::compare::run("builtin:random1000", &scene.triangles, &quick())
         .expect("runs");
-    assert_eq!(report.runs.len(), 6);
+    // obvhs (and tinybvh, with the C++ peers) are measured as two adapters each.
+    let two_adapters = if cfg!(feature = "cpp-peers") { 2 } else { 1 };
+    assert_eq!(report.runs.len(), LIBRARIES.len() + two_adapters);
     for r in &report.runs {
         for g in r.agreement.iter().chain(&r.agreement_mt) {
             assert!(g.rays > 0);
@@ -107,4 +109,78 @@ fn bad_input_is_one_error_line() {
         assert!(!err.contains("panicked"), "{a:?}: {err}");
     }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The C++ adapters (feature `cpp-peers`; CI builds without it, so only a machine with Embree
+/// installed runs this) against brute force: every triangle tested per ray with rdbvh's
+/// double-sided test, on all three ray sets, before the comparison's own agreement check with
+/// rdbvh is asserted for both of their trees.
+#[cfg(feature = "cpp-peers")]
+#[test]
+fn cpp_peers_agree_with_brute_force_and_rdbvh() {
+    use rdbvh_benches::peers::{Embree, Library, Prepared, TinybvhBvh4, TinybvhBvh8};
+    use rdbvh_benches::{agreement, bounds, ray_set, Answers, RayKind};
+
+    rdbvh_benches::peers::embree::available().expect("Embree 3 is installed");
+    rdbvh_benches::peers::tinybvh::available().expect("tinybvh matches its adapter");
+    let scene = rdbvh::scene::Scene::open("builtin:random1000").unwrap();
+    let tris = &scene.triangles;
+    let b = bounds(tris);
+    fn check<L: Library>(
+        tris: &[rdbvh_core::geometry::Triangle],
+        rays: &[rdbvh_core::geometry::Ray],
+        brute: &Answers,
+        kind: RayKind,
+    ) {
+        let g = agreement(brute, &Prepared::<L>::new(tris).answers(&L::rays(rays)));
+        assert!(
+            g.closest >= MIN_AGREEMENT && g.any >= MIN_AGREEMENT,
+            "{} {}: {g:?}",
+            L::NAME,
+            kind.name()
+        );
+    }
+    for kind in [RayKind::Camera, RayKind::Random, RayKind::Shadow] {
+        let rays = ray_set(tris, &b, kind);
+        assert!(rays.len() > 1000, "{}: {} rays", kind.name(), rays.len());
+        let brute = Answers {
+            closest: rays
+                .iter()
+                .map(|r| {
+                    tris.iter().fold(None::<f32>, |best, t| {
+                        t.intersect(r, best.unwrap_or(r.t_max))
+                            .map(|h| h.t)
+                            .or(best)
+                    })
+                })
+                .collect(),
+            any: rays
+                .iter()
+                .map(|r| tris.iter().any(|t| t.intersect(r, r.t_max).is_some()))
+                .collect(),
+        };
+        let hits = brute.any.iter().filter(|&&h| h).count();
+        assert!(
+            hits > rays.len() / 20 && hits < rays.len(),
+            "{}: {hits} hits",
+            kind.name()
+        );
+        check::<Embree>(tris, &rays, &brute, kind);
+        check::<TinybvhBvh8>(tris, &rays, &brute, kind);
+        check::<TinybvhBvh4>(tris, &rays, &brute, kind);
+    }
+    let report = rdbvh_benches::compare::run("builtin:random1000", tris, &quick()).expect("runs");
+    for name in ["embree", "tinybvh-bvh8", "tinybvh-bvh4"] {
+        let r = report
+            .runs
+            .iter()
+            .find(|r| r.name == name)
+            .unwrap_or_else(|| panic!("{name} measured"));
+        for g in r.agreement.iter().chain(&r.agreement_mt) {
+            assert!(
+                g.rays > 0 && g.closest >= MIN_AGREEMENT && g.any >= MIN_AGREEMENT,
+                "{name}: {g:?}"
+            );
+        }
+    }
 }

@@ -1,0 +1,81 @@
+// tinybvh (the single header shipped in the tinybvh-rs crate) behind a small C ABI for the
+// `peers` comparison: builds of BVH8_CPU and BVH4_CPU with or without tinybvh's threaded
+// builder, and the two queries, one ray at a time. Compiled by benches/build.rs with
+// -O3 -march=native (tinybvh's BVH8_CPU needs AVX2 and FMA).
+#define TINYBVH_IMPLEMENTATION
+#include "tiny_bvh.h"
+
+#include <cstdint>
+#include <new>
+
+using tinybvh::bvhvec3;
+using tinybvh::bvhvec4;
+
+namespace {
+
+// The binary BVH inside each layout: its builder decides the threading.
+tinybvh::BVH& inner_of(tinybvh::BVH8_CPU& b) { return b.bvh8.bvh; }
+tinybvh::BVH& inner_of(tinybvh::BVH4_CPU& b) { return b.bvh4.bvh; }
+
+template <typename B>
+void* build_layout(const float* verts, uint32_t tris, bool threaded) {
+    B* b = new (std::nothrow) B();
+    if (!b) return nullptr;
+    // Cleared before the build: tinybvh clears it itself under 50k triangles, never sets it.
+    inner_of(*b).threadedBuild = threaded;
+    b->Build(reinterpret_cast<const bvhvec4*>(verts), tris);
+    return b;
+}
+
+template <typename B>
+float closest(const void* b, const tinybvh::Ray* ray) {
+    tinybvh::Ray r = *ray;
+    static_cast<const B*>(b)->Intersect(r);
+    return r.hit.t;
+}
+
+template <typename B>
+bool occluded(const void* b, const tinybvh::Ray* ray) {
+    return static_cast<const B*>(b)->IsOccluded(*ray);
+}
+
+}  // namespace
+
+extern "C" {
+
+// The size and alignment of tinybvh::Ray, for the Rust side's opaque copy.
+uint32_t rdbvh_tinybvh_ray_size() { return sizeof(tinybvh::Ray); }
+uint32_t rdbvh_tinybvh_ray_align() { return alignof(tinybvh::Ray); }
+
+// tinybvh's own ray constructor (it normalises the direction and sets 1/D) into `out`, which
+// has room and alignment for a tinybvh::Ray. `t` is the segment end along the unit direction.
+void rdbvh_tinybvh_ray(const float* o, const float* d, float t, void* out) {
+    new (out) tinybvh::Ray(bvhvec3(o[0], o[1], o[2]), bvhvec3(d[0], d[1], d[2]), t);
+}
+
+// `verts`: 3 * tris vertices of 4 floats each (x, y, z, unused), 16-byte aligned. Null when
+// out of memory.
+void* rdbvh_tinybvh8_build(const float* verts, uint32_t tris, bool threaded) {
+    return build_layout<tinybvh::BVH8_CPU>(verts, tris, threaded);
+}
+void rdbvh_tinybvh8_free(void* b) { delete static_cast<tinybvh::BVH8_CPU*>(b); }
+// The hit distance along the unit direction, or the ray's own `t` (its segment end) on a miss.
+float rdbvh_tinybvh8_closest(const void* b, const void* ray) {
+    return closest<tinybvh::BVH8_CPU>(b, static_cast<const tinybvh::Ray*>(ray));
+}
+bool rdbvh_tinybvh8_occluded(const void* b, const void* ray) {
+    return occluded<tinybvh::BVH8_CPU>(b, static_cast<const tinybvh::Ray*>(ray));
+}
+
+void* rdbvh_tinybvh4_build(const float* verts, uint32_t tris, bool threaded) {
+    return build_layout<tinybvh::BVH4_CPU>(verts, tris, threaded);
+}
+void rdbvh_tinybvh4_free(void* b) { delete static_cast<tinybvh::BVH4_CPU*>(b); }
+float rdbvh_tinybvh4_closest(const void* b, const void* ray) {
+    return closest<tinybvh::BVH4_CPU>(b, static_cast<const tinybvh::Ray*>(ray));
+}
+bool rdbvh_tinybvh4_occluded(const void* b, const void* ray) {
+    return occluded<tinybvh::BVH4_CPU>(b, static_cast<const tinybvh::Ray*>(ray));
+}
+
+}  // extern "C"

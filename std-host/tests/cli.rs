@@ -3,7 +3,7 @@
 //! against the brute-force oracle on built-in and real scenes.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use rdbvh::scene::{Mt19937, Scene};
 use rdbvh_core::brute_force;
@@ -11,41 +11,12 @@ use rdbvh_core::geometry::Ray;
 use rdbvh_core::influence::{InfluenceArea, PointDistribution, RaySampler};
 use rdbvh_core::Vec3;
 
-fn rdbvh(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rdbvh"))
-        .args(args)
-        .output()
-        .expect("the rdbvh binary runs")
-}
+mod common;
+use common::{rdbvh, shared_scenes, text};
 
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-/// The shared scenes beside the workspace, or `None` (with a note) when they are not checked out.
-/// Under `CI=true` their absence is a failure, not a skip.
-fn shared_scenes(test: &str) -> Option<PathBuf> {
-    let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/scenes"));
-    if dir.is_dir() {
-        return Some(dir.to_path_buf());
-    }
-    assert!(
-        std::env::var("CI").as_deref() != Ok("true"),
-        "CI=true but {} is missing",
-        dir.display()
-    );
-    eprintln!(
-        "{test}: real scenes skipped: {} not found (check out ../shared beside the workspace)",
-        dir.display()
-    );
-    None
-}
-
-/// A fresh scratch folder for one test.
+/// A fresh scratch folder for one test of this suite.
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("rdbvh-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::scratch("cli", name)
 }
 
 #[test]

@@ -3,47 +3,17 @@
 //! one-line errors for bad lights and cameras.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use rdbvh::cli::read_rays;
 use rdbvh::scene::Scene;
 use rdbvh_core::brute_force;
 
-fn rdbvh(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rdbvh"))
-        .args(args)
-        .output()
-        .expect("the rdbvh binary runs")
-}
+mod common;
+use common::{rdbvh, shared_scenes, text};
 
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-/// The shared scenes beside the workspace, or `None` (with a note) when they are not checked out.
-/// Under `CI=true` their absence is a failure, not a skip.
-fn shared_scenes(test: &str) -> Option<PathBuf> {
-    let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/scenes"));
-    if dir.is_dir() {
-        return Some(dir.to_path_buf());
-    }
-    assert!(
-        std::env::var("CI").as_deref() != Ok("true"),
-        "CI=true but {} is missing",
-        dir.display()
-    );
-    eprintln!(
-        "{test}: real scenes skipped: {} not found (check out ../shared beside the workspace)",
-        dir.display()
-    );
-    None
-}
-
-/// A fresh scratch folder for one test.
+/// A fresh scratch folder for one test of this suite.
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("rdbvh-render-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::scratch("render", name)
 }
 
 /// The room seen from inside, small and fast.

@@ -28,7 +28,7 @@ impl Answers {
         }
     }
 
-    /// Writes the answers as CSV. Floats use Rust's shortest round-trip formatting, so reading
+    /// Writes the answers as CSV. Floats use the shortest formatting that reads back exactly, so reading
     /// them back as `f32` gives the same bits, except that a negative zero (a barycentric on an
     /// edge, rounded from the wrong side) is written `0`, not `-0`.
     pub fn write_csv(&self, out: &mut impl Write) -> std::io::Result<()> {

@@ -27,7 +27,7 @@ pub use builder::{chooser_name, BuilderArgs, BuilderKind, BuiltBvh, PresetArg};
 pub use error::CliError;
 pub use experiment::ExperimentArgs;
 pub use rays::{parse_rays, read_rays, write_rays, RaysError, OPTIONAL_COLUMNS, REQUIRED_COLUMNS};
-pub use render::{RenderArgs, RenderReport, StructureArg};
+pub use render::{RenderArgs, RenderReport};
 pub use structure::{trace_structure, StructureTrace, DEFAULT_LOCAL_PRESET};
 pub use trace::{trace, LookupKind, TraceArgs};
 

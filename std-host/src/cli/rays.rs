@@ -46,7 +46,7 @@ impl fmt::Display for RaysError {
 impl std::error::Error for RaysError {}
 
 /// Writes `rays` as CSV with every column, `ox,oy,oz,dx,dy,dz,tmin,tmax`, in Rust's shortest
-/// round-trip float formatting: [`read_rays`] gives back the same rays, bit for bit (an
+/// float formatting that reads back exactly: [`read_rays`] gives back the same rays, bit for bit (an
 /// infinite `tmax` is written `inf`).
 pub fn write_rays<'a>(
     out: &mut impl std::io::Write,

@@ -5,7 +5,7 @@ use std::fs;
 use std::io::{BufWriter, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 
-use clap::{value_parser, Args, ValueEnum};
+use clap::{value_parser, Args};
 use rdbvh_core::geometry::Ray;
 use rdbvh_core::Vec3;
 use serde::Serialize;
@@ -18,25 +18,6 @@ use crate::render::{
     to_srgb8, Camera, FrameSettings, Integrator, LightSet, RecordedRays, RenderError, Structure,
     StructureKind, DEFAULT_FOV_DEG,
 };
-
-/// `--structure`: which structure answers the shadow rays.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum StructureArg {
-    /// The global BVH: binned SAH with reinsertion, 4-wide nodes.
-    Global,
-    /// A light buffer per light (per cluster of emissive triangles), built from the lights; the
-    /// global BVH answers what a buffer does not.
-    Lights,
-}
-
-impl From<StructureArg> for StructureKind {
-    fn from(s: StructureArg) -> Self {
-        match s {
-            StructureArg::Global => StructureKind::Global,
-            StructureArg::Lights => StructureKind::Lights,
-        }
-    }
-}
 
 /// Arguments of `rdbvh render`.
 #[derive(Args, Clone, Debug)]
@@ -83,8 +64,8 @@ pub struct RenderArgs {
     pub fov: f32,
     /// Which structure answers the shadow rays (camera and bounce rays always use the global
     /// BVH); every structure gives the same image, byte for byte.
-    #[arg(long, value_enum, default_value_t = StructureArg::Global)]
-    pub structure: StructureArg,
+    #[arg(long, value_enum, default_value_t = StructureKind::Global)]
+    pub structure: StructureKind,
     /// Single-thread replays of the frame's shadow rays for shadow_ms (the best one counts).
     #[arg(long, value_name = "N", default_value_t = 5, value_parser = value_parser!(u32).range(1..=100))]
     pub shadow_replays: u32,
@@ -183,15 +164,13 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
         .build()
         .map_err(|e| CliError::Usage(format!("cannot start {} threads: {e}", args.threads)))?;
     let report = pool.install(|| render(args))?;
-    if !args.json {
-        return print_summary(&report, out).map_err(CliError::Stdout);
+    print_summary(&report, out).map_err(CliError::Stdout)?;
+    if args.json {
+        let json = serde_json::to_string(&report).map_err(std::io::Error::other);
+        json.and_then(|json| writeln!(out, "{json}"))
+            .map_err(CliError::Stdout)?;
     }
-    print_summary(&report, out)
-        .and_then(|()| {
-            let json = serde_json::to_string(&report).map_err(std::io::Error::other)?;
-            writeln!(out, "{json}")
-        })
-        .map_err(CliError::Stdout)
+    Ok(())
 }
 
 /// Loads, builds, renders, replays and writes; runs on the current thread pool.
@@ -213,7 +192,7 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         args.width,
         args.height,
     )?;
-    let structure = Structure::build(args.structure.into(), &scene.triangles, lights.lights())?;
+    let structure = Structure::build(args.structure, &scene.triangles, lights.lights())?;
     let integrator = Integrator::new(&scene, &lights, &structure, args.max_bounces)?;
     let settings = FrameSettings {
         width: args.width,

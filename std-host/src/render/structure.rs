@@ -17,8 +17,8 @@ use super::light_structure::light_buffers;
 use super::{Light, RenderError};
 use crate::parallel;
 
-/// Which structure answers the shadow rays.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Which structure answers the shadow rays (`--structure`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum StructureKind {
     /// The global BVH: binned SAH with reinsertion (Bittner et al. 2013), collapsed to 4-wide
     /// nodes, the fastest single BVH rdbvh builds for these rays.
@@ -106,7 +106,13 @@ impl Structure {
     /// Whether anything blocks the shadow segment `ray` toward light `light`.
     #[inline]
     pub fn occluded(&self, light: usize, ray: &Ray) -> bool {
-        self.occluded_counted(light, ray, &mut TraversalStats::default())
+        let buffer = self.buffer_of[light];
+        if buffer != NO_BUFFER {
+            if let Some(answer) = self.buffers[buffer as usize].occluded(ray) {
+                return answer;
+            }
+        }
+        self.global.any_hit(ray)
     }
 
     /// [`Structure::occluded`], counting node and triangle tests in `stats` (a light buffer's

@@ -106,7 +106,7 @@ mod tests {
                 for (p, q) in [(a.v0, b.v0), (a.v1, b.v1), (a.v2, b.v2)] {
                     assert!((p - q).abs().max_element() <= 1e-4, "{file} triangle {i}");
                 }
-                // Nine printed digits round-trip f32, so the match is in fact exact.
+                // Nine printed digits read back as the same f32, so the match is in fact exact.
                 assert_eq!(a, b, "{file} triangle {i}");
             }
         }

@@ -14,7 +14,7 @@ use serde_json::{json, Value};
 use super::areas::load_areas;
 use super::{load_scene, CliError};
 use crate::experiment::{
-    build_fallback, run_one, sample_rays, settings_of, ExperimentError, RunMetrics, RunSetup,
+    build_fallback, run_one, settings_of, ExperimentError, RaySource, RunMetrics, RunSetup,
     Settings,
 };
 
@@ -55,6 +55,11 @@ pub struct AnalyzeArgs {
     /// `[settings]` rays_per_config, else 1000).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub rays: Option<u32>,
+    /// Measure every area on these rays instead of its sampler (as `experiment
+    /// --recorded-rays`): a CSV as `rdbvh trace --rays` reads it, such as `rdbvh render
+    /// --record-rays` writes.
+    #[arg(long, value_name = "RAYS.csv", conflicts_with = "rays")]
+    pub recorded_rays: Option<PathBuf>,
     /// The thesis's builder, constants, fallback and ray sampler (as `experiment --thesis-mode`,
     /// with the builder keys of the file's `[settings]` when it has them, as an experiment file
     /// does).
@@ -349,7 +354,9 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
     // Before any work, as clap's own checks are: a bad column must not wait for the analysis.
     let columns = node_columns(args.columns.as_deref())?;
     if let Some(nodes) = &args.nodes {
-        super::check_output(nodes, &[Path::new(&args.scene), args.areas.as_path()])?;
+        let mut inputs = vec![Path::new(&args.scene), args.areas.as_path()];
+        inputs.extend(args.recorded_rays.as_deref());
+        super::check_output(nodes, &inputs)?;
         if args.columns.is_some() && is_json(nodes) {
             return Err(CliError::Usage(
                 "--columns chooses the CSV export's columns; a .json export writes every field"
@@ -358,6 +365,7 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
         }
     }
     let (scene, _) = load_scene(&args.scene, args.nodes.as_deref())?;
+    let source = super::rays::ray_source(args.recorded_rays.as_deref())?;
     let entries = load_areas(&args.areas, &scene)?;
     // Read again for its [settings] (load_areas has read it whole already).
     let text = std::fs::read_to_string(&args.areas)
@@ -366,7 +374,7 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
     let fallback = build_fallback(&scene.triangles, &setup)?;
     let mut reports = Vec::new();
     for (i, entry) in entries.iter().enumerate() {
-        let rays = sample_rays(&entry.area, &setup, entry.index as u64 + 1);
+        let rays = source.rays_for(&entry.area, entry.index, &setup);
         let m = run_one(
             &scene.triangles,
             &entry.area,
@@ -401,13 +409,20 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
                 write_nodes(path, &rows, &columns)?;
             }
         }
-        reports.push(metrics_json(entry.index + 1, kind, &m, c.error()));
+        let mut report = metrics_json(entry.index + 1, kind, &m, c.error());
+        // The rays the structure gives the local BVH: all of a sampler's, some of a recording's.
+        report["affine_rays"] = json!(rays.iter().filter(|r| entry.area.is_affine(r)).count());
+        reports.push(report);
     }
     let doc = json!({
         "scene": scene.name,
         "triangles": scene.triangles.len(),
         "preset": preset.name(),
         "mode": if args.thesis_mode { "thesis" } else { "project" },
+        "ray_source": match source {
+            RaySource::Sampled => "sampled",
+            RaySource::Recorded { .. } => "recorded",
+        },
         "areas": reports,
     });
     let w = CliError::Stdout;
@@ -417,7 +432,7 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
     }
     writeln!(
         out,
-        "{}: {} triangles, preset {}, {} mode",
+        "{}: {} triangles, preset {}, {} mode, {}",
         scene.name,
         scene.triangles.len(),
         preset.name(),
@@ -425,7 +440,8 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
             "thesis"
         } else {
             "project"
-        }
+        },
+        source.describe(setup.rays)
     )
     .map_err(w)?;
     for r in &reports {

@@ -42,6 +42,12 @@ pub struct ExperimentArgs {
     /// Rays per run (overrides rays_per_config).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub rays: Option<u32>,
+    /// Measure every run on these rays instead of the areas' samplers: a CSV as `rdbvh trace
+    /// --rays` reads it, such as `rdbvh render --record-rays` writes. All of them go through
+    /// the structure (its local BVH takes those the area's affinity test accepts) and through
+    /// the fallback alone.
+    #[arg(long, value_name = "RAYS.csv", conflicts_with = "rays")]
+    pub recorded_rays: Option<PathBuf>,
     /// Heuristics to run, comma-separated: full, longest, facing, standard, sah, pah (overrides
     /// heuristics).
     #[arg(long, value_name = "a,b", value_delimiter = ',')]
@@ -84,6 +90,7 @@ pub fn run(args: &ExperimentArgs, out: &mut dyn Write) -> Result<(), CliError> {
             octree_levels: args.octree_levels,
         },
         progress: std::io::stderr().is_terminal(),
+        rays: super::rays::ray_source(args.recorded_rays.as_deref())?,
     };
     let s = run_experiment(&opts, &mut std::io::stderr())?;
     let w = |e| CliError::Stdout(e);

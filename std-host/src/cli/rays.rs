@@ -1,5 +1,5 @@
-//! Batches of rays in CSV: the input of `rdbvh trace`, and what `rdbvh render --record-rays`
-//! writes.
+//! Batches of rays in CSV: the input of `rdbvh trace` (and of `analyze` and `experiment` with
+//! `--recorded-rays`), and what `rdbvh render --record-rays` writes.
 //!
 //! The format is what a user can write from any tool: a header naming the columns, found by name
 //! in any order, `ox,oy,oz,dx,dy,dz` required and `tmin,tmax` optional (defaults 0 and +inf).
@@ -13,6 +13,8 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
+use super::CliError;
+use crate::experiment::RaySource;
 use crate::text_lines::line_at;
 
 use rdbvh_core::geometry::Ray;
@@ -77,6 +79,28 @@ pub fn read_rays(path: &Path) -> Result<Vec<Ray>, RaysError> {
         reason: format!("cannot open: {e}"),
     })?;
     parse_text(&text, path, PIECE_BYTES)
+}
+
+/// The ray source of `analyze` and `experiment`: the rays of `--recorded-rays FILE.csv` when it
+/// is given, else the areas' samplers. A file with no ray is an error (there would be nothing to
+/// measure).
+pub fn ray_source(recorded: Option<&Path>) -> Result<RaySource, CliError> {
+    let Some(path) = recorded else {
+        return Ok(RaySource::Sampled);
+    };
+    let rays = read_rays(path)?;
+    if rays.is_empty() {
+        return Err(RaysError {
+            path: path.to_path_buf(),
+            line: None,
+            reason: "holds no ray (--recorded-rays needs at least one)".into(),
+        }
+        .into());
+    }
+    Ok(RaySource::Recorded {
+        path: path.to_path_buf(),
+        rays,
+    })
 }
 
 /// Reads every ray of CSV text from `reader`; `label` names it in errors.

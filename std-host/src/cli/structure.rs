@@ -27,7 +27,7 @@ use crate::parallel::build_scene;
 /// pricing its cuts with the area's PAH ([`SceneOptions`]'s default too). Over the thesis's 48
 /// configurations with published scenes (20,000 rays each), its local trees' closest-hit cost per
 /// ray is 0.98x the `sah` trees' (geometric mean; 0.69x to 1.32x), the thesis's `full` 1.07x
-/// (0.69x to 1.69x); any hit 0.99x and 1.04x. `benches/RESULTS.md`, twelfth session.
+/// (0.69x to 1.69x); any hit 0.99x and 1.04x (`benches/RESULTS.md`).
 pub const DEFAULT_LOCAL_PRESET: Preset = Preset::Pah;
 
 /// What tracing a batch through the structure did, with the fallback BVH alone as the baseline.

@@ -32,6 +32,7 @@
 
 mod error;
 mod plots;
+mod ray_source;
 mod report;
 mod results;
 mod run;
@@ -41,6 +42,7 @@ mod toplevel_study;
 
 pub use error::ExperimentError;
 pub use plots::fonts_available;
+pub use ray_source::RaySource;
 pub use results::{
     header, read_table, read_thesis_files, read_thesis_results, thesis_result_files, RunRow, Table,
     THESIS_COLUMNS,
@@ -91,6 +93,8 @@ pub struct ExperimentOptions {
     pub thesis_results: Option<PathBuf>,
     /// Overrides.
     pub overrides: Overrides,
+    /// The rays each run measures with.
+    pub rays: RaySource,
     /// Show a progress bar on standard error.
     pub progress: bool,
 }
@@ -348,6 +352,9 @@ pub fn run_experiment(
     if let Some((_, files)) = &thesis_results {
         inputs.extend(files.iter().map(PathBuf::as_path));
     }
+    if let RaySource::Recorded { path, .. } = &opts.rays {
+        inputs.push(path);
+    }
     for output in report::output_files(&opts.out) {
         if let Some(input) = crate::same_file::input_named_by(&output, inputs.iter().copied()) {
             let why = format!(
@@ -381,7 +388,7 @@ pub fn run_experiment(
         .par_iter()
         .map(|&(i, entry, path, preset)| {
             let (scene, fallback) = &scenes[path];
-            let rays = sample_rays(&entry.area, &setup, entry.index as u64 + 1);
+            let rays = opts.rays.rays_for(&entry.area, entry.index, &setup);
             let metrics = run_one(
                 &scene.triangles,
                 &entry.area,

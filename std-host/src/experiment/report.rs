@@ -88,10 +88,10 @@ pub fn write_report(
     let _ = writeln!(md, "# Experiment report\n");
     let _ = writeln!(
         md,
-        "- file: `{}`\n- {mode}\n- {} runs, {} rays per run, octree of {} levels\n- {:.1} s wall clock",
+        "- file: `{}`\n- {mode}\n- {} runs, {}, octree of {} levels\n- {:.1} s wall clock",
         opts.file.display(),
         s.rows.len(),
-        settings.rays_per_config,
+        opts.rays.describe(settings.rays_per_config),
         settings.octree_levels,
         s.seconds
     );

@@ -34,7 +34,7 @@ def tests(j):
 print(f"| {name} | {g['triangles']:,} | {g['shadow_rays']:,} | {tests(g)} → {tests(l)} "
       f"| {g['shadow_ms']:.0f} → {l['shadow_ms']:.0f} ms, **{l['shadow_ms'] / g['shadow_ms']:.2f}x** "
       f"| {l['render_ms'] / g['render_ms']:.2f}x | {g['build_ms']:.0f} → {l['build_ms']:.0f} ms "
-      f"({l['light_buffers']}) | {same} |")
+      f"({l['light_buffers']} kept, {l['light_buffers_dropped']} dropped) | {same} |")
 PY
 }
 

@@ -105,6 +105,9 @@ fn json_has_the_contract_keys() {
         "max_bounces",
         "seed",
         "threads",
+        "light_buffers",
+        "light_buffers_dropped",
+        "pilot_shadow_rays",
     ] {
         assert!(json.get(key).is_some(), "{key} missing: {json}");
     }
@@ -288,4 +291,43 @@ fn cornell_box_with_every_light_kind_is_identical_across_structures() {
     );
     assert_eq!(global["shadow_occluded"], buffered["shadow_occluded"]);
     assert!(global["mean_luminance"].as_f64().unwrap() > 0.01);
+}
+
+/// The pilot frame drops the Cornell box's buffer: its quad light is large next to the box, so
+/// the buffer's cells hold most of the triangles and save too few tests (README, headline table).
+/// The image stays the global BVH's.
+#[test]
+fn the_pilot_drops_a_buffer_that_does_not_pay() {
+    let Some(scenes) = shared_scenes("the_pilot_drops_a_buffer_that_does_not_pay") else {
+        return;
+    };
+    let dir = scratch("pilot");
+    let obj = scenes.join("cornell_box.obj");
+    let scene = [
+        obj.to_str().unwrap(),
+        "--width",
+        "512",
+        "--height",
+        "512",
+        "--spp",
+        "1",
+    ];
+    let global = render(&scene, &dir.join("global.png"), &["--structure", "global"]);
+    let lights = render(&scene, &dir.join("lights.png"), &["--structure", "lights"]);
+    assert_eq!(global["pilot_shadow_rays"], 0);
+    assert!(
+        lights["pilot_shadow_rays"].as_u64().unwrap() > 1000,
+        "{lights}"
+    );
+    assert_eq!(
+        (
+            lights["light_buffers"].as_u64(),
+            lights["light_buffers_dropped"].as_u64()
+        ),
+        (Some(0), Some(1))
+    );
+    assert_eq!(global["shadow_node_tests"], lights["shadow_node_tests"]);
+    let png = |n: &str| std::fs::read(dir.join(n)).unwrap();
+    assert_eq!(png("global.png"), png("lights.png"));
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -14,9 +14,9 @@ use super::answers::{write_answers, Answers};
 use super::rays::write_rays;
 use super::{load_scene, CliError};
 use crate::render::{
-    emissive_lights, encode_png, mean_luminance, read_lights, render_frame, replay_shadow_rays,
-    to_srgb8, Camera, FrameSettings, Integrator, LightSet, RecordedRays, RenderError, Structure,
-    StructureKind, DEFAULT_FOV_DEG,
+    emissive_lights, encode_png, mean_luminance, pilot_size, prune_by_pilot, read_lights,
+    render_frame, replay_shadow_rays, to_srgb8, Camera, FrameSettings, Integrator, LightSet,
+    RecordedRays, RenderError, Structure, StructureKind, DEFAULT_FOV_DEG,
 };
 
 /// Arguments of `rdbvh render`.
@@ -105,8 +105,13 @@ pub struct RenderReport {
     pub triangles: usize,
     /// Lights the renderer samples (emissive triangles and the lights file's).
     pub lights: usize,
-    /// Light buffers built (0 for `global`).
+    /// Light buffers in use (0 for `global`): those built that the pilot frame kept.
     pub light_buffers: usize,
+    /// Light buffers built and dropped because the pilot frame's shadow rays showed that they
+    /// do not pay (their lights use the global BVH).
+    pub light_buffers_dropped: usize,
+    /// Shadow segments of the pilot frame (0 when there was no buffer to decide on).
+    pub pilot_shadow_rays: usize,
     /// Image width.
     pub width: u32,
     /// Image height.
@@ -121,7 +126,8 @@ pub struct RenderReport {
     pub threads: usize,
     /// `global` or `lights`.
     pub structure: &'static str,
-    /// Wall-clock milliseconds of the structure's build (global BVH and light buffers).
+    /// Wall-clock milliseconds of the structure's build (global BVH, light buffers and the pilot
+    /// frame that chose among them).
     pub build_ms: f64,
     /// Wall-clock milliseconds of the frame.
     pub render_ms: f64,
@@ -184,15 +190,28 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         scene: scene.name.clone(),
     })?;
     let framing = Camera::framing(scene.bounds, args.fov, args.width, args.height)?;
-    let camera = Camera::new(
-        args.eye.unwrap_or(framing.eye()),
-        args.look_at.unwrap_or(scene.bounds.center()),
-        args.up.unwrap_or(Vec3::Y),
-        args.fov,
-        args.width,
-        args.height,
+    let camera_of = |(width, height)| {
+        Camera::new(
+            args.eye.unwrap_or(framing.eye()),
+            args.look_at.unwrap_or(scene.bounds.center()),
+            args.up.unwrap_or(Vec3::Y),
+            args.fov,
+            width,
+            height,
+        )
+    };
+    let camera = camera_of((args.width, args.height))?;
+    let mut structure = Structure::build(args.structure, &scene.triangles, lights.lights())?;
+    let size = pilot_size(args.width, args.height);
+    let pilot = prune_by_pilot(
+        &mut structure,
+        &scene,
+        &lights,
+        args.max_bounces,
+        &camera_of(size)?,
+        size,
+        args.seed,
     )?;
-    let structure = Structure::build(args.structure, &scene.triangles, lights.lights())?;
     let integrator = Integrator::new(&scene, &lights, &structure, args.max_bounces)?;
     let settings = FrameSettings {
         width: args.width,
@@ -223,6 +242,8 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         triangles: scene.len(),
         lights: lights.lights().len(),
         light_buffers: structure.light_buffers().len(),
+        light_buffers_dropped: pilot.dropped,
+        pilot_shadow_rays: pilot.shadow_rays,
         width: args.width,
         height: args.height,
         spp: args.spp,
@@ -284,10 +305,13 @@ fn print_summary(r: &RenderReport, out: &mut impl Write) -> std::io::Result<()> 
         "structure {}: built in {:.1} ms{}",
         r.structure,
         r.build_ms,
-        if r.light_buffers > 0 {
-            format!(" ({} light buffers)", r.light_buffers)
-        } else {
-            String::new()
+        match (r.light_buffers, r.light_buffers_dropped) {
+            (0, 0) => String::new(),
+            (kept, 0) => format!(" ({kept} light buffers)"),
+            (kept, dropped) => format!(
+                " ({kept} light buffers; {dropped} dropped by the pilot frame's {} shadow rays)",
+                r.pilot_shadow_rays
+            ),
         }
     )?;
     writeln!(

@@ -14,7 +14,8 @@
 //! - **Determinism.** Every random number is a hash of (seed, pixel, sample, dimension)
 //!   ([`sampler`]): the image depends on the seed alone, not on threads or tiles.
 //! - **Structures.** Camera and bounce rays go through the global BVH; shadow segments through
-//!   the [`Structure`] chosen (`global`, or `lights`: a light buffer per light). Both answer
+//!   the [`Structure`] chosen (`global`, or `lights`: a light buffer per light where a pilot
+//!   frame shows it pays, [`pilot`]). Both answer
 //!   exactly as the global BVH does, so their images are byte-identical.
 //! - **Measures.** The frame counts its rays and the shadow segments' node and triangle tests;
 //!   [`replay_shadow_rays`] times the frame's shadow segments on one thread.
@@ -27,6 +28,7 @@ pub mod integrator;
 mod light;
 mod light_structure;
 pub mod lights_file;
+pub mod pilot;
 mod replay;
 pub mod sampler;
 mod structure;
@@ -41,5 +43,6 @@ pub use integrator::{Integrator, ShadowRay, SHADOW_END};
 pub use light::{emissive_lights, luminance, Light, LightSample, LightSet};
 pub use light_structure::{CLUSTER_EXTENT, MAX_LIGHT_BUFFERS};
 pub use lights_file::{parse_lights, read_lights};
+pub use pilot::{pilot_size, prune_by_pilot, PilotReport, KEEP_RATIO, PILOT_DIVISOR};
 pub use replay::replay_shadow_rays;
 pub use structure::{Structure, StructureKind};

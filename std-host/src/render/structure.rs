@@ -24,7 +24,8 @@ pub enum StructureKind {
     /// nodes, the fastest single BVH rdbvh builds for these rays.
     Global,
     /// A light buffer per light (per cluster of emissive triangles), built from the lights
-    /// automatically, with the global BVH for what a buffer does not answer.
+    /// automatically and kept where a pilot frame's shadow rays show that it pays
+    /// ([`super::pilot`]), with the global BVH for what a buffer does not answer.
     Lights,
 }
 
@@ -95,6 +96,40 @@ impl Structure {
     /// The global BVH.
     pub fn global(&self) -> &WideBvh {
         &self.global
+    }
+
+    /// The index of `light`'s buffer, if it has one.
+    pub fn buffer_of(&self, light: usize) -> Option<usize> {
+        let b = self.buffer_of[light];
+        (b != NO_BUFFER).then_some(b as usize)
+    }
+
+    /// Keeps the buffers whose `keep` entry is true (one per buffer, in order) and sends the
+    /// others' lights to the global BVH.
+    pub(super) fn keep_buffers(&mut self, keep: &[bool]) {
+        let mut new_index = vec![NO_BUFFER; self.buffers.len()];
+        let mut next = 0;
+        for (b, &k) in keep.iter().enumerate() {
+            if k {
+                new_index[b] = next;
+                next += 1;
+            }
+        }
+        let mut b = 0;
+        self.buffers.retain(|_| {
+            b += 1;
+            keep[b - 1]
+        });
+        for slot in &mut self.buffer_of {
+            if *slot != NO_BUFFER {
+                *slot = new_index[*slot as usize];
+            }
+        }
+    }
+
+    /// Adds work done after the build that belongs to it (the pilot frame) to its time.
+    pub(super) fn add_build_ms(&mut self, ms: f64) {
+        self.build_ms += ms;
     }
 
     /// The closest hit of a camera or bounce ray: always the global BVH.

@@ -24,7 +24,7 @@ use criterion::{
 use rdbvh_benches::compare::{plane_area_over, point_area_over};
 use rdbvh_benches::peers::{BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Rdbvh, RdbvhWide};
 use rdbvh_benches::{bounds, load_scene, single_thread_pool, RdbvhReuse, BENCH_SCENES};
-use rdbvh_core::build::{BuildArena, Builder, Preset, PresetOptions, ReinsertConfig, Reinserter};
+use rdbvh_core::builder::{BuildArena, Builder, Preset, PresetOptions, ReinsertConfig, Reinserter};
 use rdbvh_core::bvh::{Bvh, WideBvh};
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::heuristics::Sah;

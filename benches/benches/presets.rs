@@ -19,7 +19,7 @@ use clock::Clock;
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use rdbvh_benches::areas::{plane_area_facing, point_area_facing};
 use rdbvh_benches::{bounds, load_scene, BENCH_SCENES};
-use rdbvh_core::build::{BuildArena, Preset, PresetOptions};
+use rdbvh_core::builder::{BuildArena, Preset, PresetOptions};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::influence::InfluenceArea;
 

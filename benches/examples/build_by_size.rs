@@ -5,7 +5,7 @@
 //! two rows is the time the nodes between the two sizes take, with their splits, partitions and
 //! node writes.
 
-use rdbvh_core::build::{BuildConfig, Builder};
+use rdbvh_core::builder::{BuildConfig, Builder};
 use rdbvh_core::heuristics::{AllAxes, Sah, SahTermination, Termination};
 
 /// [`SahTermination`], and every node of at most `.0` primitives a leaf before it is priced.

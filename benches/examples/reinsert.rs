@@ -19,7 +19,7 @@ use glam::Vec3;
 use rdbvh_benches::{
     bounds, load_scene, pinhole_rays, random_rays, ray_set, thread_cpu_seconds, RayKind,
 };
-use rdbvh_core::build::{Builder, ReinsertConfig, Reinserter};
+use rdbvh_core::builder::{Builder, ReinsertConfig, Reinserter};
 use rdbvh_core::bvh::{Bvh, TraversalStats, WideBvh};
 use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 use rdbvh_core::heuristics::{CostConstants, Sah};

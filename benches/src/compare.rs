@@ -28,7 +28,7 @@ use std::fmt::Write as _;
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use rdbvh_core::build::{BuildArena, Builder, Preset, PresetOptions};
+use rdbvh_core::builder::{BuildArena, Builder, Preset, PresetOptions};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 use rdbvh_core::influence::{InfluenceArea, PlaneArea, PointArea};
@@ -641,7 +641,7 @@ struct SerialTop<'a> {
     cutoff: u32,
     arena: BuildArena,
     top: Bvh,
-    jobs: Vec<rdbvh_core::build::Subtree>,
+    jobs: Vec<rdbvh_core::builder::Subtree>,
     out: Bvh,
 }
 

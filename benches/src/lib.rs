@@ -14,7 +14,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use rdbvh_core::build::{BuildArena, Builder};
+use rdbvh_core::builder::{BuildArena, Builder};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 

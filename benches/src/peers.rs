@@ -32,7 +32,7 @@
 //! - **Embree 3** and **tinybvh 1.6.8** (feature `cpp-peers`): see `embree` and `tinybvh`.
 
 use glam::{Vec3, Vec3A};
-use rdbvh_core::build::{reinsert, Builder, ReinsertConfig};
+use rdbvh_core::builder::{reinsert, Builder, ReinsertConfig};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::Sah;
 
@@ -166,7 +166,7 @@ impl Library for Rdbvh {
 }
 
 /// rdbvh's 4-wide BVH, as a renderer that traces many rays per build would make it: the binary
-/// SAH tree, improved by reinsertion ([`rdbvh_core::build::reinsert`], default settings, under
+/// SAH tree, improved by reinsertion ([`rdbvh_core::builder::reinsert`], default settings, under
 /// SAH), then collapsed into nodes whose four child boxes are tested with one SIMD slab test, with
 /// its own copy of the triangles in 4-wide leaf blocks (issue 6). Its build time includes all
 /// three steps; its traversals use that copy, not the scene.

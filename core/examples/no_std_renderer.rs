@@ -36,7 +36,7 @@ use std::error::Error;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rdbvh_core::brute_force;
-use rdbvh_core::build::{BuildArena, Builder};
+use rdbvh_core::builder::{BuildArena, Builder};
 use rdbvh_core::bvh::{Bvh, TraversalStats};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::Vec3;

@@ -22,7 +22,7 @@ use std::f32::consts::{PI, TAU};
 use std::time::Instant;
 
 use rdbvh_core::brute_force;
-use rdbvh_core::build::Builder;
+use rdbvh_core::builder::Builder;
 use rdbvh_core::bvh::{Bvh, Hit, Traversable, TraversalStats, WideBvh};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::{CostConstants, Sah};

@@ -18,7 +18,7 @@ pub enum BuildError {
     /// More primitives than `u32` indices can address.
     TooManyPrimitives,
     /// A subset's id names no triangle of the slice
-    /// ([`crate::build::BuildArena::load_triangle_subset`]).
+    /// ([`crate::builder::BuildArena::load_triangle_subset`]).
     NoSuchPrimitive {
         /// The id, or `None` when it is not a `u32` at all (negative, or too large).
         index: Option<u32>,

@@ -6,7 +6,7 @@
 //! depth bound makes provably large enough, and checks everything against a brute-force oracle.
 //!
 //! ```
-//! use rdbvh_core::{build::{Builder, BuildArena}, geometry::{Ray, Triangle}, Vec3};
+//! use rdbvh_core::{builder::{Builder, BuildArena}, geometry::{Ray, Triangle}, Vec3};
 //!
 //! let tris = [Triangle::new(Vec3::new(-1.0, -1.0, 2.0), Vec3::new(1.0, -1.0, 2.0), Vec3::new(0.0, 1.0, 2.0))];
 //! let bvh = Builder::sah().build(&tris).unwrap();
@@ -23,7 +23,7 @@ extern crate alloc;
 
 pub mod analyze;
 pub mod brute_force;
-pub mod build;
+pub mod builder;
 pub mod bvh;
 pub mod error;
 pub mod geometry;

@@ -5,7 +5,7 @@
 
 use arbitrary::{Result, Unstructured};
 use libfuzzer_sys::fuzz_target;
-use rdbvh_core::build::{reinsert, BuildArena, Builder, Preset, ReinsertConfig};
+use rdbvh_core::builder::{reinsert, BuildArena, Builder, Preset, ReinsertConfig};
 use rdbvh_core::bvh::{Bvh, WideBvh, MAX_DEPTH};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::{CostConstants, Sah};

@@ -7,7 +7,7 @@ use std::path::Path;
 use libfuzzer_sys::fuzz_target;
 use rdbvh::cli::parse_rays;
 use rdbvh::scene::{MaterialFiles, Scene};
-use rdbvh_core::build::Builder;
+use rdbvh_core::builder::Builder;
 
 fuzz_target!(|data: &[u8]| {
     let Some((&kind, rest)) = data.split_first() else {

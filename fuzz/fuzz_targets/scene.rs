@@ -6,7 +6,7 @@
 use arbitrary::{Result, Unstructured};
 use libfuzzer_sys::fuzz_target;
 use rdbvh_core::brute_force;
-use rdbvh_core::build::Preset;
+use rdbvh_core::builder::Preset;
 use rdbvh_core::geometry::Ray;
 use rdbvh_core::influence::{PointDistribution, RaySampler};
 use rdbvh_core::toplevel::{AreaLookup, Octree, Scene, SceneOptions};

@@ -10,7 +10,7 @@
 
 use arbitrary::{Result, Unstructured};
 use rdbvh_core::brute_force;
-use rdbvh_core::build::{BinSpace, BuildConfig, CutEvaluation, PresetOptions, ThesisCut};
+use rdbvh_core::builder::{BinSpace, BuildConfig, CutEvaluation, PresetOptions, ThesisCut};
 use rdbvh_core::bvh::{Bvh, WideBvh, MAX_DEPTH};
 use rdbvh_core::geometry::{Ray, RayError, Triangle};
 use rdbvh_core::heuristics::PerspectiveMeasure;
@@ -213,7 +213,7 @@ pub fn build_config(u: &mut Unstructured) -> Result<BuildConfig> {
         0 => 2,
         1 => 3,
         2 => 16,
-        _ => u.int_in_range(2..=rdbvh_core::build::MAX_BINS)?,
+        _ => u.int_in_range(2..=rdbvh_core::builder::MAX_BINS)?,
     };
     let max_depth = match u.int_in_range(0u8..=3)? {
         0 => u.int_in_range(1..=MAX_DEPTH)?,
@@ -231,7 +231,7 @@ pub fn build_config(u: &mut Unstructured) -> Result<BuildConfig> {
     } else {
         BinSpace::Centroids
     };
-    let exhaustive_max = u.int_in_range(0..=rdbvh_core::build::MAX_EXHAUSTIVE)?;
+    let exhaustive_max = u.int_in_range(0..=rdbvh_core::builder::MAX_EXHAUSTIVE)?;
     Ok(BuildConfig {
         bins,
         max_depth,
@@ -250,7 +250,7 @@ pub fn preset_options(u: &mut Unstructured) -> Result<PresetOptions> {
         PresetOptions::default()
     };
     if u.arbitrary()? {
-        o.bins = u.int_in_range(2..=rdbvh_core::build::MAX_BINS)?;
+        o.bins = u.int_in_range(2..=rdbvh_core::builder::MAX_BINS)?;
     }
     if u.arbitrary()? {
         o.max_leaf = u.int_in_range(1..=16)?;

@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use rdbvh::scene::Scene;
-use rdbvh_core::build::{reinsert, Builder, ReinsertConfig};
+use rdbvh_core::builder::{reinsert, Builder, ReinsertConfig};
 use rdbvh_core::bvh::{TraversalStats, WideBvh};
 use rdbvh_core::geometry::Ray;
 use rdbvh_core::heuristics::Sah;

@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use rdbvh_core::build::Clock;
+use rdbvh_core::builder::Clock;
 
 /// Nanoseconds since the clock was made, from `std::time::Instant` (monotonic).
 #[derive(Clone, Copy, Debug)]
@@ -35,7 +35,7 @@ impl Clock for StdClock {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rdbvh_core::build::{BuildArena, Builder};
+    use rdbvh_core::builder::{BuildArena, Builder};
     use rdbvh_core::bvh::Bvh;
     use rdbvh_core::geometry::Triangle;
     use rdbvh_core::Vec3;

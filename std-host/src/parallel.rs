@@ -20,7 +20,7 @@ use std::cmp::{Ordering, Reverse};
 use std::collections::BinaryHeap;
 use std::sync::Mutex;
 
-use rdbvh_core::build::{
+use rdbvh_core::builder::{
     BinJob, BuildArena, Builder, GraftBlock, LoadedBounds, NodeBinner, NodeBins, Preset,
     PresetError, PresetOptions, PresetVisitor, Subtree, SubtreeSink, TriangleLoad,
 };
@@ -381,7 +381,7 @@ pub fn build_scene<L: AreaLookup>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rdbvh_core::build::{BuildConfig, ReinsertConfig};
+    use rdbvh_core::builder::{BuildConfig, ReinsertConfig};
     use rdbvh_core::heuristics::{AllAxes, PahPerspective, PerspectiveMeasure, SahTermination};
     use rdbvh_core::influence::InfluenceArea;
     use rdbvh_core::influence::{PlaneArea, PointArea};

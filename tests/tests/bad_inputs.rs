@@ -7,7 +7,7 @@ use std::path::Path;
 
 use rdbvh::scene::{MaterialFiles, Scene as ObjScene, SceneError as ObjError};
 use rdbvh_core::brute_force;
-use rdbvh_core::build::{BuildArena, BuildConfig, Builder, Preset, PresetOptions};
+use rdbvh_core::builder::{BuildArena, BuildConfig, Builder, Preset, PresetOptions};
 use rdbvh_core::bvh::{Bvh, WideBvh};
 use rdbvh_core::geometry::{Ray, RayError, Triangle};
 use rdbvh_core::influence::{AreaError, InfluenceArea, PlaneArea, PointArea, RaySampler};

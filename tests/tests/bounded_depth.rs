@@ -3,7 +3,7 @@
 //! traversals' fixed stacks (`MAX_DEPTH + 1` entries) can never overflow. Each tree is also
 //! validated and queried against brute force, which exercises those stacks at the deepest level.
 
-use rdbvh_core::build::{
+use rdbvh_core::builder::{
     BinSpace, BuildArena, BuildConfig, Builder, CutEvaluation, Preset, PresetOptions, ThesisCut,
 };
 use rdbvh_core::bvh::{Bvh, WideBvh, MAX_DEPTH};

@@ -5,7 +5,7 @@
 //! `cargo test -p rdbvh-tests --release -- --ignored` lists exactly what still fails.
 
 use rdbvh_core::brute_force;
-use rdbvh_core::build::{BuildArena, Builder};
+use rdbvh_core::builder::{BuildArena, Builder};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::{BuildError, Vec3};
 
@@ -119,7 +119,7 @@ fn core_bug_rounding_hit_outside_triangle_box() {
 /// returns triangle 2 where the oracle's tie rule gives triangle 0 (0, 2 and 3 are duplicates).
 #[test]
 fn core_bug_ordered_prune_breaks_tie_rule() {
-    use rdbvh_core::build::BuildConfig;
+    use rdbvh_core::builder::BuildConfig;
     use rdbvh_core::heuristics::{AllAxes, LeafSize, Sah};
     let t = Triangle::new(
         Vec3::new(0.117_943_935, 0.0, -0.172_248_54),

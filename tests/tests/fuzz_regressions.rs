@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use rdbvh_core::brute_force;
-use rdbvh_core::build::Builder;
+use rdbvh_core::builder::Builder;
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::PerspectiveMeasure;
 use rdbvh_core::influence::{InfluenceArea, PointArea};

@@ -9,7 +9,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::hint::black_box;
 
-use rdbvh_core::build::{
+use rdbvh_core::builder::{
     BinSpace, BuildArena, BuildConfig, Builder, CutEvaluation, ReinsertConfig, Reinserter,
     ThesisCut,
 };

@@ -6,7 +6,7 @@
 
 use rdbvh::areas::read_areas;
 use rdbvh::scene::Scene;
-use rdbvh_core::build::{AreaPah, BuildArena, Preset, PresetOptions};
+use rdbvh_core::builder::{AreaPah, BuildArena, Preset, PresetOptions};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::heuristics::{PerspectiveMeasure, Sah};

@@ -9,7 +9,7 @@
 use proptest::prelude::*;
 use proptest::sample::Index;
 use rdbvh_core::brute_force;
-use rdbvh_core::build::{
+use rdbvh_core::builder::{
     reinsert, BinSpace, BuildArena, BuildConfig, Builder, CutEvaluation, ReinsertConfig, ThesisCut,
 };
 use rdbvh_core::bvh::{Bvh, WideBvh};
@@ -326,7 +326,7 @@ proptest! {
         bins in prop_oneof![Just(2u32), Just(3), Just(4), Just(7), Just(16), Just(64)],
         s in scale(),
         (cut, bin_space) in cut_and_space(),
-        exhaustive_max in 0u32..=rdbvh_core::build::MAX_EXHAUSTIVE,
+        exhaustive_max in 0u32..=rdbvh_core::builder::MAX_EXHAUSTIVE,
     ) {
         // The scene's scale comes with the scene; `s` only scales free ray origins, so rays also
         // start far inside or far outside the scene.

@@ -12,7 +12,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use rdbvh::scene::Scene;
-use rdbvh_core::build::{reinsert, BuildArena, Builder, ReinsertConfig};
+use rdbvh_core::builder::{reinsert, BuildArena, Builder, ReinsertConfig};
 use rdbvh_core::bvh::{Bvh, WideBvh};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::{CostConstants, Sah};

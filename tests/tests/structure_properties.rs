@@ -9,7 +9,7 @@
 
 use proptest::prelude::*;
 use rdbvh_core::brute_force;
-use rdbvh_core::build::{Preset, ReinsertConfig};
+use rdbvh_core::builder::{Preset, ReinsertConfig};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::influence::{InfluenceArea, PlaneArea, PointArea, RaySampler};
 use rdbvh_core::toplevel::{Octree, Scene, SceneOptions};

@@ -26,7 +26,7 @@ use std::time::Instant;
 
 use rdbvh_benches::compare::{plane_area_over, point_area_over};
 use rdbvh_benches::{load_scene, thread_cpu_seconds};
-use rdbvh_core::build::{AreaPah, BuildArena, Builder, Preset, PresetError, PresetOptions};
+use rdbvh_core::builder::{AreaPah, BuildArena, Builder, Preset, PresetError, PresetOptions};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::heuristics::{CostConstants, Sah};

@@ -8,7 +8,7 @@
 //!
 //! ```
 //! use rdbvh_core::analyze::{analyze, Analysis, EstimatedCost, NodeView, TreeShape};
-//! use rdbvh_core::build::Builder;
+//! use rdbvh_core::builder::Builder;
 //! use rdbvh_core::bvh::Bvh;
 //! use rdbvh_core::geometry::Triangle;
 //! use rdbvh_core::heuristics::CostConstants;

@@ -172,7 +172,7 @@ mod tests {
     use alloc::vec::Vec;
 
     use super::*;
-    use crate::build::Builder;
+    use crate::builder::Builder;
     use crate::bvh::{WideBvh, WideNode};
     use crate::geometry::Triangle;
     use crate::heuristics::LeafSize;

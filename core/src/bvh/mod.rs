@@ -43,7 +43,7 @@ pub struct Bvh {
 
 impl Bvh {
     /// An empty BVH with room for a build over `prims` primitives (at most `2 prims - 1` nodes), so
-    /// that [`crate::build::Builder::build_into`] does not allocate: 68 bytes per primitive (two
+    /// that [`crate::builder::Builder::build_into`] does not allocate: 68 bytes per primitive (two
     /// 32-byte nodes and a 4-byte index). Like `Vec::with_capacity`, it panics past `isize::MAX`
     /// bytes and aborts when the allocation fails; [`Bvh::try_with_capacity`] reports both.
     pub fn with_capacity(prims: usize) -> Self {

@@ -333,7 +333,7 @@ mod tests {
 
     use super::*;
     use crate::brute_force;
-    use crate::build::Builder;
+    use crate::builder::Builder;
 
     /// The stack's one unsafe read: pops return exactly what was pushed, in reverse, and an
     /// empty stack pops nothing (small enough for Miri, which the test command runs on it).

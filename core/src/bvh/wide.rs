@@ -87,7 +87,7 @@ impl WideBvh {
     /// A binary subtree of at most this many triangles always becomes one leaf of the wide tree,
     /// in one [`Triangle4`] block, whatever its shape: one 4-wide test replaces the subtree's box
     /// tests and its one or two scalar leaf tests. So a binary build meant only for the collapse
-    /// need not split such nodes ([`crate::build::Builder::for_wide`]).
+    /// need not split such nodes ([`crate::builder::Builder::for_wide`]).
     pub const ONE_BLOCK: u32 = 4;
 
     /// Collapses a binary BVH built over `tris` into the 4-wide tree of least SAH cost that keeps
@@ -268,7 +268,7 @@ fn small_subtree(bvh: &Bvh, b: u32) -> Option<([u32; LEAF_BLOCK], usize)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::build::{BinSpace, BuildConfig, Builder, CutEvaluation, ThesisCut};
+    use crate::builder::{BinSpace, BuildConfig, Builder, CutEvaluation, ThesisCut};
     use crate::heuristics::{AxisChooser, CostModel, LeafSize, Termination};
     use crate::test_scenes::soup;
 

@@ -371,7 +371,7 @@ mod tests {
 
     use super::*;
     use crate::brute_force;
-    use crate::build::Builder;
+    use crate::builder::Builder;
     use crate::bvh::Bvh;
     use crate::geometry::Triangle;
     use crate::random::Pcg32;

@@ -66,7 +66,7 @@ impl AxisChooser for AllAxes {
 }
 
 /// The longest splitting plane heuristic (LSPH): axes by decreasing extent, each rated by its
-/// extent over the longest one. With [`crate::build::CutEvaluation::FirstAxis`] only the longest
+/// extent over the longest one. With [`crate::builder::CutEvaluation::FirstAxis`] only the longest
 /// is tried; with the thesis's cut evaluation (threshold 0.99) the next one only when it is
 /// nearly as long.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

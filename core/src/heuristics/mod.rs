@@ -16,7 +16,7 @@
 //! splits along z, and a stop rule by leaf size and depth:
 //!
 //! ```
-//! use rdbvh_core::build::{BuildConfig, Builder};
+//! use rdbvh_core::builder::{BuildConfig, Builder};
 //! use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 //! use rdbvh_core::heuristics::{AxisChooser, AxisOrder, CostModel, Termination};
 //! use rdbvh_core::Vec3;

@@ -56,7 +56,7 @@ impl Termination for LeafSize {
 
 /// Another rule, plus: a node of at most `min_leaf` primitives is a leaf at once, before any split
 /// is priced (Embree's minimum leaf size). For trees that are collapsed afterwards, where what a
-/// small node would split into is thrown away ([`crate::build::Builder::for_wide`]).
+/// small node would split into is thrown away ([`crate::builder::Builder::for_wide`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MinLeaf<T> {
     /// The rule for every larger node.

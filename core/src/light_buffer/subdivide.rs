@@ -11,7 +11,7 @@ use super::buffer::{LightBuffer, LightBufferOptions, LightBufferStats, CLEAR, DA
 use super::cell::{CellRect, CONE_MARGIN, FACES};
 use super::clip::Region;
 use super::source::{LightSource, MARGIN};
-use crate::build::{BuildArena, Builder};
+use crate::builder::{BuildArena, Builder};
 use crate::bvh::{Bvh, WideBvh};
 use crate::geometry::Triangle;
 use crate::BuildError;

@@ -4,7 +4,7 @@ use alloc::vec::Vec;
 use core::fmt;
 
 use super::{AreaList, AreaLookup, BreakEven, Octree};
-use crate::build::{BuildArena, Preset, PresetError, PresetOptions, ReinsertConfig};
+use crate::builder::{BuildArena, Preset, PresetError, PresetOptions, ReinsertConfig};
 use crate::bvh::{Bvh, Hit, Traversable, TraversalStats, WideBvh};
 use crate::geometry::{Ray, Triangle};
 use crate::heuristics::CostConstants;

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use rdbvh_core::analyze::{analyze, containment, NodeRecord, NodeRecords, THESIS_LEVELS};
-use rdbvh_core::build::{AreaPah, Preset};
+use rdbvh_core::builder::{AreaPah, Preset};
 use rdbvh_core::heuristics::Sah;
 use rdbvh_core::influence::InfluenceArea;
 use rdbvh_core::toplevel::Octree;
@@ -88,7 +88,7 @@ pub struct AnalyzeArgs {
 /// The run set-up of `experiment` for the areas file's `[settings]` (see [`settings_of`]) and
 /// the arguments.
 fn setup(args: &AnalyzeArgs, file: &Settings) -> RunSetup {
-    use rdbvh_core::build::PresetOptions;
+    use rdbvh_core::builder::PresetOptions;
     use rdbvh_core::influence::PointDistribution;
     let s = Settings {
         rays_per_config: args.rays.unwrap_or(file.rays_per_config),
@@ -393,7 +393,7 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
             if let Some(path) = &args.nodes {
                 // The same build again, for its per-node records.
                 let ids: Vec<u32> = entry.area.triangles_in(&scene.triangles).collect();
-                let mut arena = rdbvh_core::build::BuildArena::with_capacity(ids.len());
+                let mut arena = rdbvh_core::builder::BuildArena::with_capacity(ids.len());
                 arena.load_triangle_subset(&scene.triangles, ids)?;
                 let mut bvh = rdbvh_core::bvh::Bvh::with_capacity(arena.len());
                 preset

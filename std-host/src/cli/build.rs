@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use rdbvh_core::build::AreaPah;
+use rdbvh_core::builder::AreaPah;
 use rdbvh_core::heuristics::{CostConstants, Sah};
 
 use serde::Serialize;

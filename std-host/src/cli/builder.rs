@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use clap::builder::PossibleValue;
 use clap::{value_parser, Args, ValueEnum};
-use rdbvh_core::build::{
+use rdbvh_core::builder::{
     reinsert, BuildArena, BuildConfig, Builder, Preset, PresetOptions, ReinsertConfig,
     ReinsertStats, MAX_BINS,
 };

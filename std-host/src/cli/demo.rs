@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use rdbvh_core::brute_force;
-use rdbvh_core::build::Preset;
+use rdbvh_core::builder::Preset;
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::{CostConstants, Sah};
 use rdbvh_core::influence::{InfluenceArea, PlaneArea, RaySampler};

@@ -5,7 +5,7 @@ use std::fmt;
 use std::io;
 use std::path::PathBuf;
 
-use rdbvh_core::build::PresetError;
+use rdbvh_core::builder::PresetError;
 use rdbvh_core::toplevel::SceneError as StructureError;
 use rdbvh_core::BuildError;
 

@@ -7,7 +7,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use rdbvh_core::build::{Preset, PresetOptions, ReinsertConfig};
+use rdbvh_core::builder::{Preset, PresetOptions, ReinsertConfig};
 use rdbvh_core::bvh::{Bvh, TraversalStats};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::CostConstants;

@@ -59,7 +59,7 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use rdbvh_core::build::{Preset, PresetOptions};
+use rdbvh_core::builder::{Preset, PresetOptions};
 use rdbvh_core::influence::{InfluenceArea, PointDistribution};
 
 use crate::areas::AreaEntry;

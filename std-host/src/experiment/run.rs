@@ -5,7 +5,7 @@ use std::time::Instant;
 use rdbvh_core::analyze::{
     analyze, Epo, EstimatedCost, OverlapSpace, RayCostSums, RayCosts, SiblingOverlap, TreeShape,
 };
-use rdbvh_core::build::{AreaPah, BuildArena, Preset, PresetOptions};
+use rdbvh_core::builder::{AreaPah, BuildArena, Preset, PresetOptions};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::CostConstants;
@@ -45,7 +45,7 @@ pub struct RunMetrics {
     pub build_ms: f64,
     /// Phase times and calls of a second, profiled build of the same local BVH (timing every
     /// phase slows a build, so `build_ms` comes from the unprofiled one).
-    pub profile: rdbvh_core::build::PhaseProfile,
+    pub profile: rdbvh_core::builder::PhaseProfile,
     /// Shape of the local BVH.
     pub shape: rdbvh_core::analyze::ShapeReport,
     /// PAH estimate per ray of the area (over its window measure).

@@ -3,7 +3,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use rdbvh_core::build::{Preset, PresetOptions, ThesisCut};
+use rdbvh_core::builder::{Preset, PresetOptions, ThesisCut};
 use rdbvh_core::heuristics::CostConstants;
 use serde::Deserialize;
 
@@ -214,7 +214,7 @@ pub fn parse_presets<'a>(
 
 /// The most candidate planes per axis `candidate_planes` (and `--candidate-planes`) may name: a
 /// node box gets one bin more than planes, and a sweep at most 64 bins.
-pub const MAX_CANDIDATE_PLANES: u32 = rdbvh_core::build::MAX_BINS - 1;
+pub const MAX_CANDIDATE_PLANES: u32 = rdbvh_core::builder::MAX_BINS - 1;
 
 /// The line (from 1) of `key = ...` in the file's `[settings]` table, if it is written there.
 fn settings_line(text: &str, key: &str) -> Option<usize> {

@@ -7,7 +7,7 @@
 
 use std::time::Instant;
 
-use rdbvh_core::build::{reinsert, Builder, ReinsertConfig};
+use rdbvh_core::builder::{reinsert, Builder, ReinsertConfig};
 use rdbvh_core::bvh::{Hit, TraversalStats, WideBvh};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::Sah;

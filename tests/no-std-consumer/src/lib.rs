@@ -11,7 +11,7 @@ use core::cell::UnsafeCell;
 use core::sync::atomic::{AtomicUsize, Ordering};
 
 use rdbvh_core::brute_force;
-use rdbvh_core::build::{BuildArena, Builder};
+use rdbvh_core::builder::{BuildArena, Builder};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::Vec3;

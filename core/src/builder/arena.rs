@@ -667,10 +667,10 @@ mod tests {
         );
         assert_eq!(arena.capacity(), tris.len());
         arena.load_triangles(&tris).unwrap();
-        crate::build::Builder::sah()
+        crate::builder::Builder::sah()
             .build_into(&mut arena, &mut out)
             .unwrap();
-        assert_eq!(out, crate::build::Builder::sah().build(&tris).unwrap());
+        assert_eq!(out, crate::builder::Builder::sah().build(&tris).unwrap());
     }
 
     #[test]

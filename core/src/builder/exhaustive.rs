@@ -18,8 +18,8 @@
 //! 166.0M with five. The split found is the optimal one, and cheaper to find than a binned one.
 
 use super::arena::{lanes_to_aabb, soa, Bin, PrimRef};
-use super::builder::Cut;
 use super::config::MAX_EXHAUSTIVE;
+use super::cut::Cut;
 use super::keys::cheapest_lane;
 use crate::heuristics::CostModel;
 use crate::simd::Aabb4;

@@ -1,12 +1,14 @@
 //! The build skeleton: choose axes, bin, sweep, then stop or split. Heuristics are type parameters.
 
-use super::arena::{lanes_to_aabb, Bin, BuildArena, PrimRefs, Sweep, Task};
-use super::binning::{BinJob, NodeBinner, SerialBinner, BIN_BYTES};
+use super::apply_split::*;
+use super::arena::{Bin, BuildArena, Task};
+use super::bin_map::*;
+use super::binning::{BinJob, NodeBinner, SerialBinner};
 use super::config::{BinSpace, BuildConfig, CutEvaluation};
-use super::exhaustive::{cheapest_bipartition, partition_by_mask};
-use super::keys::cheapest_lane;
-use super::partition::{centroid_bounds, swap_misplaced};
+use super::cut::*;
+use super::exhaustive::cheapest_bipartition;
 use super::profile::{Clock, NoClock, PhaseProfile};
+use super::sweep::*;
 use crate::bvh::{Bvh, BvhNode, WideBvh};
 use alloc::vec::Vec;
 
@@ -17,7 +19,6 @@ use crate::heuristics::{
     AllAxes, AxisChooser, AxisOrder, CostModel, LongestAxis, MinLeaf, Sah, SahTermination,
     Termination,
 };
-use crate::simd::Aabb4;
 use crate::BuildError;
 
 /// A subtree left for a separate build by [`Builder::build_top`]: the placeholder leaf `node`
@@ -117,142 +118,6 @@ impl Builder<LongestAxis> {
     }
 }
 
-/// One side of a split: its bounds, primitive count and (doubled) centroid bounds.
-type Child = (Aabb, u32, Aabb);
-
-/// A priced candidate split, with what pricing it under any other cost model needs: the cheapest
-/// bin boundary of a sweep along one axis, or the cheapest bipartition of a tiny node
-/// ([`super::exhaustive`]).
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Cut {
-    /// Where it cuts: the first bin of the right side, or the bipartition's mask.
-    pub at: usize,
-    pub left: Aabb,
-    pub right: Aabb,
-    pub n_left: u32,
-    pub n_right: u32,
-    /// `m(L)` and `m(R)` under the model the cut is priced with, kept from the sweep: a
-    /// perspective PAH measure costs hundreds of instructions, so it is never taken twice.
-    pub measure_left: f32,
-    pub measure_right: f32,
-    /// `m(L) n_L + m(R) n_R` under that model.
-    pub weighted: f32,
-}
-
-impl Cut {
-    /// The same cut priced under `model` instead of the model that found it: both sides in
-    /// one 4-wide evaluation, with what `model` settled for the node (`hint`, 0 for nothing).
-    #[inline]
-    pub(crate) fn priced_under(self, model: &impl CostModel, hint: u32) -> Cut {
-        let (l, r) = (self.left, self.right);
-        let m = model
-            .measure4_hinted(&Aabb4::from_boxes([l, r, l, r]), hint)
-            .to_array();
-        let (ml, mr) = (m[0], m[1]);
-        Cut {
-            measure_left: ml,
-            measure_right: mr,
-            weighted: ml * self.n_left as f32 + mr * self.n_right as f32,
-            ..self
-        }
-    }
-
-    /// The thesis's cut ratio `(m(L) + m(R)) / m(parent)` under the model that chose the cut.
-    #[inline]
-    fn ratio(&self, parent: f32) -> f32 {
-        (self.measure_left + self.measure_right) / parent
-    }
-}
-
-/// A node's chosen split: the axis and the cut along it.
-#[derive(Clone, Copy, Debug)]
-struct Split {
-    axis: usize,
-    cut: Cut,
-}
-
-/// Maps a doubled centroid coordinate to its bin along one axis.
-#[derive(Clone, Copy, Debug)]
-struct BinMap {
-    min: f32,
-    scale: f32,
-    last: f32,
-}
-
-impl BinMap {
-    /// `None` when the range has no extent (no plane can separate the centroids).
-    #[inline]
-    fn new(min: f32, max: f32, bins: u32) -> Option<Self> {
-        let extent = max - min;
-        // The scale is shrunk by a few ulps so the largest centroid maps inside the last bin.
-        let scale = bins as f32 * (1.0 - 4.0 * f32::EPSILON) / extent;
-        // The binning pass multiplies the scale by the bin size (`BinJob`): that product must
-        // stay finite too, or it would put every centroid above `min` in the last bin while the
-        // partition classifies by this scale. Only centroid extents below 2e-37 per bin have no
-        // map (no plane then separates them, as for coincident centroids).
-        (extent > 0.0 && (scale * BIN_BYTES).is_finite()).then_some(Self {
-            min,
-            scale,
-            last: (bins - 1) as f32,
-        })
-    }
-
-    #[inline(always)]
-    fn bin(&self, c: f32) -> usize {
-        // `as usize` saturates (NaN to 0), and the clamp keeps rounding inside the bins.
-        ((c - self.min) * self.scale).clamp(0.0, self.last) as usize
-    }
-
-    /// The smallest coordinate `t` with `self.bin(t) >= bin`, for `1 <= bin <= last`: then
-    /// `self.bin(c) < bin` exactly when `c < t`, because every step of [`BinMap::bin`] (a
-    /// subtraction, a multiplication by a positive scale, a clamp, a truncation) is monotone in
-    /// `c`. The partition classifies a primitive with one comparison instead of recomputing its
-    /// bin, and still exactly as the bins counted it.
-    fn threshold(&self, bin: usize) -> f32 {
-        // Floats in their total order as integers: `key` is monotone, so is `at_least`.
-        let key = |x: f32| {
-            let b = x.to_bits() as i32;
-            i64::from(b ^ (((b >> 31) as u32) >> 1) as i32)
-        };
-        let from_key = |k: i64| {
-            let k = k as i32;
-            f32::from_bits((k ^ (((k >> 31) as u32) >> 1) as i32) as u32)
-        };
-        let at_least = |k: i64| self.bin(from_key(k)) >= bin;
-        // bin(-inf) = 0 < bin <= last = bin(+inf): the boundary lies between.
-        let (floor, ceil) = (key(f32::NEG_INFINITY), key(f32::INFINITY));
-        // Start at the plane's position and gallop to a bracket: the estimate is off by the
-        // rounding of `min + bin / scale`, which cancellation can make many ulps of the result.
-        let k0 = key(self.min + bin as f32 / self.scale).clamp(floor, ceil);
-        let (mut lo, mut hi) = if at_least(k0) {
-            (k0 - 1, k0)
-        } else {
-            (k0, k0 + 1)
-        };
-        let mut step = 1;
-        while lo > floor && at_least(lo) {
-            hi = lo;
-            lo = (lo - step).max(floor);
-            step *= 2;
-        }
-        while hi < ceil && !at_least(hi) {
-            lo = hi;
-            hi = (hi + step).min(ceil);
-            step *= 2;
-        }
-        // Invariant: !at_least(lo) (or lo = floor), at_least(hi).
-        while hi - lo > 1 {
-            let mid = lo + (hi - lo) / 2;
-            if at_least(mid) {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        from_key(hi)
-    }
-}
-
 impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
     /// A builder from its three strategies and its settings.
     pub fn new(axes: A, cost: C, termination: T, config: BuildConfig) -> Self {
@@ -288,7 +153,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
     /// the nodes below: 43% of the bunny's binary nodes and 40% of Crytek Sponza's, 18-22% of the
     /// build's instructions.
     ///
-    /// [`crate::build::reinsert`] on the smaller tree can only move its four-triangle leaves as
+    /// [`crate::builder::reinsert`] on the smaller tree can only move its four-triangle leaves as
     /// units, and gives another wide tree: as cheap to traverse on the bunny and Crytek Sponza,
     /// 8% costlier on Sibenik. Reinsert the full build's tree when the wide tree is to be
     /// improved.
@@ -757,330 +622,6 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
     }
 }
 
-/// How a node's slots are partitioned by its split.
-#[derive(Clone, Copy, Debug)]
-enum Partition {
-    /// By the split's bin boundary along its axis, under this bin map.
-    Plane(BinMap),
-    /// The primitives (by slot, from the node's first) whose bits are set go left.
-    Mask(u32),
-}
-
-/// Applies the cut evaluation `cut` to a node whose chooser ranked the axes `order`.
-/// `sweep(axis, false)` is the cheapest cut along `axis` under the node's model (`None` where
-/// nothing separates the primitives); `sweep(axis, true)` the cheapest under SAH, re-priced under
-/// the node's model: the thesis's fallback. Ties go to the earlier axis.
-fn walk(
-    cut: CutEvaluation,
-    order: &AxisOrder,
-    parent: f32,
-    largest: usize,
-    mut sweep: impl FnMut(usize, bool) -> Option<Cut>,
-) -> Option<Split> {
-    let mut best: Option<Split> = None;
-    let mut consider = |axis: usize, best: &mut Option<Split>| {
-        if let Some(cut) = sweep(axis, false) {
-            if best.is_none_or(|b| cut.weighted < b.cut.weighted) {
-                *best = Some(Split { axis, cut });
-            }
-        }
-    };
-    match cut {
-        CutEvaluation::BestOfAxes => order.iter().for_each(|(a, _)| consider(a, &mut best)),
-        CutEvaluation::FirstAxis => {
-            if let Some((a, _)) = order.iter().next() {
-                consider(a, &mut best);
-            }
-        }
-        CutEvaluation::Thesis(thesis) => {
-            // Cut ratios come from the measures each cut keeps from its sweep.
-            for (i, (axis, quality)) in order.iter().enumerate() {
-                if i > 0 && quality < thesis.quality_threshold {
-                    break;
-                }
-                consider(axis, &mut best);
-                if best.is_some_and(|b| b.cut.ratio(parent) <= thesis.excellent_ratio) {
-                    return best;
-                }
-            }
-            return match best {
-                Some(b) if b.cut.ratio(parent) <= thesis.acceptable_ratio => Some(b),
-                // Not even acceptable: SAH on the longest axis, the thesis's fallback.
-                _ => sweep(largest, true)
-                    .map(|cut| Split { axis: largest, cut })
-                    .or(best),
-            };
-        }
-    }
-    best
-}
-
-/// The cheapest boundary of one binned axis under `model`. A suffix and a prefix pass write the
-/// boxes and counts on both sides of every boundary into SoA scratch lanes; the boundaries are
-/// then priced four at a time with [`CostModel::measure4`]. O(bins), no allocation.
-///
-/// The usual bin counts get a copy each with the count a constant, so the passes unroll without
-/// bounds checks; most nodes are small, and there this loop overhead was most of the sweep.
-fn sweep_axis<M: CostModel>(bins: &[Bin], sweep: &mut Sweep, model: &M, hint: u32) -> Option<Cut> {
-    match bins.len() {
-        4 => sweep_bins::<M, 4>(bins[..4].try_into().ok()?, sweep, model, hint),
-        8 => sweep_bins::<M, 8>(bins[..8].try_into().ok()?, sweep, model, hint),
-        12 => sweep_bins::<M, 12>(bins[..12].try_into().ok()?, sweep, model, hint),
-        16 => sweep_bins::<M, 16>(bins[..16].try_into().ok()?, sweep, model, hint),
-        _ => sweep_any(bins, sweep, model, hint),
-    }
-}
-
-#[inline(always)]
-fn sweep_bins<M: CostModel, const NB: usize>(
-    bins: &[Bin; NB],
-    sweep: &mut Sweep,
-    model: &M,
-    hint: u32,
-) -> Option<Cut> {
-    sweep_any(bins, sweep, model, hint)
-}
-
-#[inline(always)]
-fn sweep_any<M: CostModel>(bins: &[Bin], sweep: &mut Sweep, model: &M, hint: u32) -> Option<Cut> {
-    let nb = bins.len();
-    // Boundary i (1..nb) separates bins[..i] from bins[i..]; lanes past nb - 1 get empty sides.
-    let mut acc = Bin::EMPTY;
-    for i in (1..nb).rev() {
-        acc.merge(&bins[i]);
-        sweep.right.set(i, &acc);
-    }
-    acc = Bin::EMPTY;
-    for i in 1..nb {
-        acc.merge(&bins[i - 1]);
-        sweep.left.set(i, &acc);
-    }
-    // Lanes past the last boundary, up to the end of its group of four: empty on both sides, so
-    // they price as +inf (no primitive on the right) and never hold a box left by an earlier,
-    // wider sweep. Models measure each lane alone (`CostModel::measure4`), but a stale box is
-    // still measured: perspective PAH once chose its rule per group, and a stale box made a
-    // reused arena and a fresh one (a threaded job's) price the same node a few ulps apart.
-    for i in nb..=(nb - 1).div_ceil(4) * 4 {
-        sweep.left.set(i, &Bin::EMPTY);
-        sweep.right.set(i, &Bin::EMPTY);
-    }
-    // The cheapest boundary per lane, then across lanes. Boundaries with an empty side, and the
-    // padding lanes past the last boundary (count 0), price as +inf. Strict `<` keeps the first
-    // of equal prices in each lane, and the final reduction the lowest boundary among them, so
-    // ties always go to the lowest boundary.
-    let inf = f32x4::splat(f32::INFINITY);
-    let zero = f32x4::ZERO;
-    let (mut best_w, mut best_i) = (inf, f32x4::splat(-1.0));
-    let (mut best_ml, mut best_mr) = (zero, zero);
-    let mut index = f32x4::from([1.0, 2.0, 3.0, 4.0]);
-    for i in (1..nb).step_by(4) {
-        let (ml, nl) = sweep.left.lanes(i, model, hint);
-        let (mr, nr) = sweep.right.lanes(i, model, hint);
-        let valid = nl.simd_gt(zero) & nr.simd_gt(zero);
-        let w = valid.select(ml * nl + mr * nr, inf);
-        let better = w.simd_lt(best_w);
-        best_w = better.select(w, best_w);
-        best_i = better.select(index, best_i);
-        best_ml = better.select(ml, best_ml);
-        best_mr = better.select(mr, best_mr);
-        index += f32x4::splat(4.0);
-    }
-    // The cheapest lane, ties to the lowest boundary; NaN and infinite prices never win.
-    let (weighted, at, won) = cheapest_lane(best_w, best_i)?;
-    Some(Cut {
-        at,
-        left: sweep.left.bounds(at),
-        right: sweep.right.bounds(at),
-        n_left: sweep.left.count[at],
-        n_right: sweep.right.count[at],
-        measure_left: best_ml.to_array()[won],
-        measure_right: best_mr.to_array()[won],
-        weighted,
-    })
-}
-
-/// The split of a two-primitive node, without binning or sweeping, and the very split they would
-/// choose: the two centroids fall in bins `a <= b` (normally the first and the last), every
-/// boundary between them splits them alike at the same price, and the sweep keeps the lowest,
-/// `a + 1`. Among the `axes` in the order they would be swept, the first that separates the
-/// centroids wins (a later axis prices the same split no lower); `None` when `axis` does not
-/// separate them, which includes centroids that differ but share a bin (at extreme coordinates
-/// the extent overflows and the bin scale rounds to zero: the sweep finds no split there either).
-/// Half the nodes a SAH build prices hold two primitives. The price comes from
-/// [`CostModel::measure4`], like the sweep's, so it is bit for bit the sweep's.
-fn split_pair<M: CostModel>(
-    model: &M,
-    arena: &BuildArena,
-    task: &Task,
-    axis: usize,
-    nb: u32,
-) -> Option<Cut> {
-    let map = pair_map(task, axis, nb)?;
-    let s = task.start as usize;
-    let (mut left, mut right) = (s, s + 1);
-    if arena.refs.centroid2_axis(s, axis) > arena.refs.centroid2_axis(s + 1, axis) {
-        (left, right) = (right, left);
-    }
-    let (bin_left, bin_right) = (
-        map.bin(arena.refs.centroid2_axis(left, axis)),
-        map.bin(arena.refs.centroid2_axis(right, axis)),
-    );
-    if bin_left >= bin_right {
-        return None;
-    }
-    let (left, right) = (arena.refs.bounds(left), arena.refs.bounds(right));
-    let m = model
-        .measure4(&Aabb4::from_boxes([left, right, right, right]))
-        .to_array();
-    Some(Cut {
-        at: bin_left + 1,
-        left,
-        right,
-        n_left: 1,
-        n_right: 1,
-        measure_left: m[0],
-        measure_right: m[1],
-        weighted: m[0] * 1.0 + m[1] * 1.0,
-    })
-}
-
-/// The bin map of a two-primitive node along `axis`, as [`Builder::bin`] makes it, or `None`
-/// where the centroids coincide.
-fn pair_map(task: &Task, axis: usize, nb: u32) -> Option<BinMap> {
-    let (lo, hi) = (task.centroids.min[axis], task.centroids.max[axis]);
-    (hi > lo).then(|| BinMap::new(lo, hi, nb)).flatten()
-}
-
-/// `ceil(log2(n))` for `n >= 1`.
-#[inline]
-fn ceil_log2(n: u32) -> u32 {
-    32 - (n.max(1) - 1).leading_zeros()
-}
-
-/// Partitions the node's slots in place by the split's bin boundary. The child boxes come from
-/// the bins; the children's centroid bounds from the slots each side ends up with.
-fn partition(arena: &mut BuildArena, task: &Task, split: &Split, map: &BinMap) -> (Child, Child) {
-    // Finding the threshold costs a few dozen bin evaluations: small nodes classify by bin.
-    let at = split.cut.at;
-    if task.count <= THRESHOLD_MIN_COUNT {
-        partition_by(arena, task, split, |c| map.bin(c) < at)
-    } else {
-        let threshold = map.threshold(at);
-        partition_by(arena, task, split, |c| c < threshold)
-    }
-}
-
-/// Partitions a node of at most [`super::MAX_EXHAUSTIVE`] slots by the mask of its exhaustive split.
-fn partition_mask(arena: &mut BuildArena, task: &Task, split: &Split, mask: u32) -> (Child, Child) {
-    let slots = arena
-        .refs
-        .slots_mut(task.start as usize, task.count as usize);
-    let [(l_lo, l_hi), (r_lo, r_hi)] = partition_by_mask(slots, mask);
-    let cut = &split.cut;
-    (
-        (cut.left, cut.n_left, lanes_to_aabb(l_lo, l_hi)),
-        (cut.right, cut.n_right, lanes_to_aabb(r_lo, r_hi)),
-    )
-}
-
-/// Nodes of at least this size are binned into two sets of bins, even and odd slots apart, then
-/// merged: neighbouring primitives of a mesh often fall in the same bins, and growing one bin
-/// twice in a row waits on the store of the first growth.
-const DUAL_BINNING_MIN: usize = 256;
-
-/// Nodes above this size partition by [`BinMap::threshold`].
-const THRESHOLD_MIN_COUNT: u32 = 16;
-
-/// [`partition`] with the classification `goes_left` of a doubled centroid coordinate: the first
-/// `n_left` slots take the left-goers ([`swap_misplaced`], Hoare's permutation without a branch
-/// per primitive), then each side's centroid bounds are gathered in a pass of its own.
-#[inline(always)]
-fn partition_by(
-    arena: &mut BuildArena,
-    task: &Task,
-    split: &Split,
-    goes_left: impl Fn(f32) -> bool,
-) -> (Child, Child) {
-    let (axis, cut) = (split.axis, &split.cut);
-    let slots = arena
-        .refs
-        .slots_mut(task.start as usize, task.count as usize);
-    let (front, back) = slots.split_at_mut(cut.n_left as usize);
-    let paired = swap_misplaced(front, back, |r| goes_left(r.centroid2_axis(axis)));
-    // The sweep counted the left-goers with the same classification.
-    debug_assert!(paired, "the partition disagrees with the bins");
-    let ((l_lo, l_hi), (r_lo, r_hi)) = (centroid_bounds(front), centroid_bounds(back));
-    (
-        (cut.left, cut.n_left, lanes_to_aabb(l_lo, l_hi)),
-        (cut.right, cut.n_right, lanes_to_aabb(r_lo, r_hi)),
-    )
-}
-
-/// Splits the node's slots at their object median along the widest centroid axis (or in index
-/// order when all centroids coincide), in place and in O(n) expected time. Both halves get at
-/// least one slot, so depth grows by one while the node halves.
-fn median_split(refs: &mut PrimRefs, task: &Task) -> (Child, Child) {
-    let start = task.start as usize;
-    let end = start + task.count as usize;
-    let mid = start + task.count as usize / 2;
-    let axis = task.centroids.largest_axis();
-    if task.centroids.extent()[axis] > 0.0 {
-        select_nth(refs, start, end, mid, axis);
-    }
-    let gather = |from: usize, to: usize| {
-        (from..to).fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), i| {
-            let pb = refs.bounds(i);
-            (b.union(pb), c.grown(pb.min + pb.max))
-        })
-    };
-    let (lb, lc) = gather(start, mid);
-    let (rb, rc) = gather(mid, end);
-    ((lb, (mid - start) as u32, lc), (rb, (end - mid) as u32, rc))
-}
-
-/// Quickselect over slots `[lo, hi)`: afterwards slot `nth` holds the centroid that would be there
-/// in sorted order along `axis`, with no larger one before it and no smaller one after it.
-/// Iterative, with a median-of-three pivot; equal keys are spread over both sides by the Hoare
-/// scheme, so all-equal input still halves.
-fn select_nth(refs: &mut PrimRefs, mut lo: usize, mut hi: usize, nth: usize, axis: usize) {
-    while hi - lo > 1 {
-        if hi - lo == 2 {
-            if refs.centroid2_axis(lo, axis) > refs.centroid2_axis(lo + 1, axis) {
-                refs.swap(lo, lo + 1);
-            }
-            return;
-        }
-        let mid = lo + (hi - lo) / 2;
-        let (a, b, c) = (
-            refs.centroid2_axis(lo, axis),
-            refs.centroid2_axis(mid, axis),
-            refs.centroid2_axis(hi - 1, axis),
-        );
-        let pivot = a.max(b.min(c)).min(b.max(c));
-        // Hoare partition: [lo, j] <= pivot <= [j + 1, hi).
-        let (mut i, mut j) = (lo, hi - 1);
-        loop {
-            while refs.centroid2_axis(i, axis) < pivot {
-                i += 1;
-            }
-            while refs.centroid2_axis(j, axis) > pivot {
-                j -= 1;
-            }
-            if i >= j {
-                break;
-            }
-            refs.swap(i, j);
-            i += 1;
-            j -= 1;
-        }
-        if nth <= j {
-            hi = j + 1;
-        } else {
-            lo = j + 1;
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use alloc::vec::Vec;
@@ -1362,7 +903,7 @@ mod tests {
         let hint = pah.hint(&node);
         let mut fresh = BuildArena::with_capacity(0);
         let mut reused = BuildArena::with_capacity(0);
-        for i in 0..=crate::build::MAX_BINS as usize {
+        for i in 0..=crate::builder::MAX_BINS as usize {
             reused.sweep.left.set(i, &near);
             reused.sweep.right.set(i, &near);
         }

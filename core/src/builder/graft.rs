@@ -261,7 +261,7 @@ mod tests {
     use glam::Vec3;
 
     use super::*;
-    use crate::build::{BuildArena, BuildConfig, Builder};
+    use crate::builder::{BuildArena, BuildConfig, Builder};
     use crate::geometry::Triangle;
     use crate::heuristics::{
         AllAxes, AxisChooser, CostModel, PahPerspective, PerspectiveMeasure, SahTermination,

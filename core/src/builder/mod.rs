@@ -5,10 +5,12 @@
 //! parameters ([`crate::heuristics`]). All memory a build touches lives in a [`BuildArena`] sized up
 //! front, and the output [`crate::bvh::Bvh`] can be pre-sized too, so a build allocates nothing.
 
+mod apply_split;
 mod arena;
+mod bin_map;
 mod binning;
-mod builder;
 mod config;
+mod cut;
 mod exhaustive;
 mod graft;
 mod keys;
@@ -16,12 +18,14 @@ mod partition;
 mod preset;
 mod profile;
 mod reinsert;
+mod skeleton;
+mod sweep;
 
 pub use arena::{BuildArena, LoadedBounds, TriangleLoad};
 pub use binning::{BinJob, NodeBinner, NodeBins, SerialBinner};
-pub use builder::{BuildStats, Builder, Subtree, SubtreeSink};
 pub use config::{BinSpace, BuildConfig, CutEvaluation, ThesisCut, MAX_BINS, MAX_EXHAUSTIVE};
 pub use graft::{GraftBlock, GraftError};
 pub use preset::{AreaPah, Preset, PresetError, PresetOptions, PresetVisitor};
 pub use profile::{Clock, NoClock, PhaseProfile};
 pub use reinsert::{reinsert, ReinsertConfig, ReinsertStats, Reinserter};
+pub use skeleton::{BuildStats, Builder, Subtree, SubtreeSink};

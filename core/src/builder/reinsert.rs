@@ -455,7 +455,7 @@ impl Reinserter {
 /// A renderer that traces many rays per build builds, reinserts, then collapses to 4-wide nodes:
 ///
 /// ```
-/// use rdbvh_core::build::{reinsert, Builder, ReinsertConfig};
+/// use rdbvh_core::builder::{reinsert, Builder, ReinsertConfig};
 /// use rdbvh_core::bvh::WideBvh;
 /// use rdbvh_core::geometry::{Ray, Triangle};
 /// use rdbvh_core::heuristics::{CostConstants, Sah};
@@ -493,7 +493,7 @@ mod tests {
 
     use super::*;
     use crate::brute_force;
-    use crate::build::Builder;
+    use crate::builder::Builder;
     use crate::geometry::{Ray, Triangle};
     use crate::heuristics::{CostConstants, Sah};
     use crate::random::Pcg32;

@@ -13,7 +13,7 @@
 //! over its box, as in `presets.rs`) and the thesis's WoodScene (its oblique plane and point areas
 //! from `../shared/thesis/experiments.toml`). Before timing, the two answers are compared ray by
 //! ray and the mean traversal cost per ray (inner nodes + triangle tests) of each is printed.
-//! `query/SCENE/AREA/{structure,fallback}-wide`: the same after `Scene::widen` (4-wide local and
+//! `query/SCENE/AREA/{structure,fallback}-wide`: the same after `TopLevel::widen` (4-wide local and
 //! fallback BVHs), checked ray by ray against the binary scene first.
 //!
 //! Clock per `RDBVH_BENCH_CLOCK` (thread CPU time by default).
@@ -34,7 +34,7 @@ use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 use rdbvh_core::heuristics::CostConstants;
 use rdbvh_core::influence::{InfluenceArea, PlaneArea, PointArea, RaySampler};
 use rdbvh_core::toplevel::{
-    AreaList, AreaLookup, Octree, Scene, SceneOptions, SceneStats, DEFAULT_OCTREE_LEVELS,
+    AreaList, AreaLookup, Octree, TopLevel, TopLevelOptions, TopLevelStats, DEFAULT_OCTREE_LEVELS,
 };
 
 /// Area counts of the lookup benchmark.
@@ -155,10 +155,10 @@ fn query(c: &mut Criterion<Clock>) {
                 continue;
             }
         };
-        let scene = match Scene::with_octree(
+        let scene = match TopLevel::with_octree(
             &tris,
             vec![plane, point],
-            &SceneOptions::default(),
+            &TopLevelOptions::default(),
             DEFAULT_OCTREE_LEVELS,
         ) {
             Ok(s) => s,
@@ -219,12 +219,12 @@ fn query(c: &mut Criterion<Clock>) {
 
 /// Untimed: agreement of the structure with the fallback BVH, the local hit rate and the mean
 /// cost per ray of each (`C_trav = C_isect = 1`).
-fn report_costs(id: &str, scene: &Scene<Octree>, rays: &[Ray], tris: &[Triangle]) {
+fn report_costs(id: &str, scene: &TopLevel<Octree>, rays: &[Ray], tris: &[Triangle]) {
     let k = CostConstants::default();
     let (mut same, mut hits, mut local_hits, mut tried) = (0usize, 0usize, 0usize, 0usize);
     let (mut cost_s, mut cost_f) = (0f64, 0f64);
     for r in rays {
-        let mut s = SceneStats::default();
+        let mut s = TopLevelStats::default();
         let a = scene.closest_hit_with_stats(r, tris, &mut s);
         let mut f = TraversalStats::default();
         let b = scene.fallback().closest_hit_with_stats(r, tris, &mut f);

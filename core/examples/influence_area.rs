@@ -11,7 +11,7 @@
 //!   normal, holding parallel rays;
 //! - a [`PointArea`]: the frustum in front of a spot light in a corner, holding radial rays.
 //!
-//! [`Scene::with_octree`] selects each area's triangles with the exact separating-axis test,
+//! [`TopLevel::with_octree`] selects each area's triangles with the exact separating-axis test,
 //! builds its local BVH (preset `pah`: the area's projected area heuristic), the fallback BVH
 //! (preset `sah`) over every triangle, and the octree that maps a ray origin to the areas that may
 //! contain it. A query takes the local BVH of an area the ray is affine to (origin inside,
@@ -21,10 +21,10 @@
 //! Four ray sets go through it: each area's own rays ([`RaySampler`]), the plane light's rays
 //! tilted 10 degrees (inside the area but not affine), and random rays anywhere in the room. Every
 //! closest-hit and any-hit answer of the octree scene, the naive-list scene
-//! ([`Scene::with_list`]) and the 4-wide scene ([`Scene::widen`]) must equal brute force, or the
+//! ([`TopLevel::with_list`]) and the 4-wide scene ([`TopLevel::widen`]) must equal brute force, or the
 //! example exits with an error. It prints how many rays went through a local BVH, how many it
 //! answered, and the mean cost per ray (`C_trav = C_isect = 1`) through the scene against the
-//! fallback BVH alone; then each area's break-even rule ([`Scene::break_even`]).
+//! fallback BVH alone; then each area's break-even rule ([`TopLevel::break_even`]).
 
 use std::error::Error;
 use std::f32::consts::{PI, TAU};
@@ -36,7 +36,9 @@ use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 use rdbvh_core::heuristics::CostConstants;
 use rdbvh_core::influence::{InfluenceArea, PlaneArea, PointArea, PointDistribution, RaySampler};
 use rdbvh_core::random::Pcg32;
-use rdbvh_core::toplevel::{AreaList, Scene, SceneOptions, SceneStats, DEFAULT_OCTREE_LEVELS};
+use rdbvh_core::toplevel::{
+    AreaList, TopLevel, TopLevelOptions, TopLevelStats, DEFAULT_OCTREE_LEVELS,
+};
 use rdbvh_core::Vec3;
 
 /// Rays per set.
@@ -63,12 +65,12 @@ fn main() -> Result<(), Box<dyn Error>> {
     .into();
     let areas = vec![plane, point];
 
-    let options = SceneOptions::default();
+    let options = TopLevelOptions::default();
     let start = Instant::now();
-    let octree = Scene::with_octree(&tris, areas.clone(), &options, DEFAULT_OCTREE_LEVELS)?;
+    let octree = TopLevel::with_octree(&tris, areas.clone(), &options, DEFAULT_OCTREE_LEVELS)?;
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
-    let list: Scene<AreaList> = Scene::with_list(&tris, areas.clone(), &options)?;
-    let wide: Scene<_, WideBvh> = octree.clone().widen(&tris);
+    let list: TopLevel<AreaList> = TopLevel::with_list(&tris, areas.clone(), &options)?;
+    let wide: TopLevel<_, WideBvh> = octree.clone().widen(&tris);
 
     let o = octree.lookup().stats();
     println!(
@@ -122,7 +124,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         for (i, ray) in rays.iter().enumerate() {
             let expect = brute_force::closest_hit(ray, &tris);
             let occluded = brute_force::any_hit(ray, &tris);
-            let mut s = SceneStats::default();
+            let mut s = TopLevelStats::default();
             let got = octree.closest_hit_with_stats(ray, &tris, &mut s);
             let answers = [
                 (got == expect, "octree closest hit"),
@@ -184,7 +186,7 @@ struct Row {
 }
 
 impl Row {
-    fn add(&mut self, s: &SceneStats, hit: bool, cost: f32, fallback_cost: f32) {
+    fn add(&mut self, s: &TopLevelStats, hit: bool, cost: f32, fallback_cost: f32) {
         self.hits += usize::from(hit);
         self.to_local += usize::from(s.tries > 0);
         self.answered += usize::from(s.answered_by.is_some());

@@ -9,7 +9,7 @@ use rdbvh_core::brute_force;
 use rdbvh_core::builder::Preset;
 use rdbvh_core::geometry::Ray;
 use rdbvh_core::influence::{PointDistribution, RaySampler};
-use rdbvh_core::toplevel::{AreaLookup, Octree, Scene, SceneOptions};
+use rdbvh_core::toplevel::{AreaLookup, Octree, TopLevel, TopLevelOptions};
 use rdbvh_core::Vec3;
 use rdbvh_fuzz::*;
 
@@ -27,18 +27,18 @@ fn run(u: &mut Unstructured) -> Result<()> {
             areas.push(a);
         }
     }
-    let options = SceneOptions {
+    let options = TopLevelOptions {
         preset: *u.choose(&Preset::ALL)?,
         local: preset_options(u)?,
         fallback: preset_options(u)?,
         max_tries: u.int_in_range(0..=3)?,
-        ..SceneOptions::default()
+        ..TopLevelOptions::default()
     };
     // Up to 6 levels: 10 (the clamp) can make millions of cells and slows fuzzing 100x.
     let levels = u.int_in_range(0..=6)?;
 
-    let octree = Scene::with_octree(&tris, areas.clone(), &options, levels);
-    let list = Scene::with_list(&tris, areas.clone(), &options);
+    let octree = TopLevel::with_octree(&tris, areas.clone(), &options, levels);
+    let list = TopLevel::with_list(&tris, areas.clone(), &options);
     if first_non_finite(&tris).is_some() {
         assert!(
             octree.is_err() && list.is_err(),

@@ -28,7 +28,7 @@ use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::heuristics::{AxisChooser, CostModel, Termination};
 use rdbvh_core::influence::InfluenceArea;
-use rdbvh_core::toplevel::{AreaLookup, Scene, SceneError, SceneOptions};
+use rdbvh_core::toplevel::{AreaLookup, TopLevel, TopLevelError, TopLevelOptions};
 use rdbvh_core::BuildError;
 
 /// Jobs per thread: enough that uneven subtrees still balance across threads, few enough that
@@ -326,16 +326,16 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Builds a [`Scene`] with its local BVHs (one per thread at a time) and its fallback BVH (itself
-/// threaded) on all threads; equal to [`Scene::build`]'s scene.
+/// Builds a [`TopLevel`] with its local BVHs (one per thread at a time) and its fallback BVH (itself
+/// threaded) on all threads; equal to [`TopLevel::build`]'s scene.
 pub fn build_scene<L: AreaLookup>(
     tris: &[Triangle],
     areas: Vec<InfluenceArea>,
-    options: &SceneOptions,
+    options: &TopLevelOptions,
     lookup: impl FnOnce(&[InfluenceArea]) -> L,
-) -> Result<Scene<L>, SceneError> {
+) -> Result<TopLevel<L>, TopLevelError> {
     let local_build = |(i, area): (usize, &InfluenceArea)| {
-        let fail = |error: PresetError| SceneError::Local {
+        let fail = |error: PresetError| TopLevelError::Local {
             area: i as u32,
             error,
         };
@@ -355,11 +355,11 @@ pub fn build_scene<L: AreaLookup>(
     // The fallback, over every triangle, is itself built on every thread.
     let fallback_build = || {
         let mut arena = BuildArena::with_capacity(tris.len());
-        load_triangles(&mut arena, tris).map_err(|e| SceneError::Fallback(e.into()))?;
+        load_triangles(&mut arena, tris).map_err(|e| TopLevelError::Fallback(e.into()))?;
         let mut bvh = build_preset(options.fallback_preset, None, &options.fallback, &mut arena)
-            .map_err(SceneError::Fallback)?;
+            .map_err(TopLevelError::Fallback)?;
         options.reinsert_fallback(&mut bvh);
-        Ok::<_, SceneError>(bvh)
+        Ok::<_, TopLevelError>(bvh)
     };
     let (local, fallback) = rayon::join(
         || {
@@ -367,13 +367,13 @@ pub fn build_scene<L: AreaLookup>(
                 .par_iter()
                 .enumerate()
                 .map(local_build)
-                .collect::<Result<Vec<Bvh>, SceneError>>()
+                .collect::<Result<Vec<Bvh>, TopLevelError>>()
         },
         fallback_build,
     );
     let lookup = lookup(&areas);
     Ok(
-        Scene::from_parts(areas, local?, fallback?, lookup, options.max_tries)
+        TopLevel::from_parts(areas, local?, fallback?, lookup, options.max_tries)
             .expect("one local BVH per area by construction"),
     )
 }
@@ -532,15 +532,15 @@ mod tests {
                 .unwrap()
                 .into(),
         ];
-        let plain = SceneOptions::default();
-        let reinserted = SceneOptions {
+        let plain = TopLevelOptions::default();
+        let reinserted = TopLevelOptions {
             reinsert: Some(ReinsertConfig::default()),
             ..plain
         };
         let mut fallbacks = Vec::new();
         for options in [plain, reinserted] {
             let a = build_scene(&tris, areas.clone(), &options, |a| Octree::build(a, 5)).unwrap();
-            let b = Scene::with_octree(&tris, areas.clone(), &options, 5).unwrap();
+            let b = TopLevel::with_octree(&tris, areas.clone(), &options, 5).unwrap();
             assert_eq!(a.local_bvhs(), b.local_bvhs());
             assert_eq!(a.fallback(), b.fallback());
             fallbacks.push(a.fallback().clone());

@@ -11,7 +11,7 @@ use rdbvh_core::builder::{BuildArena, BuildConfig, Builder, Preset, PresetOption
 use rdbvh_core::bvh::{Bvh, WideBvh};
 use rdbvh_core::geometry::{Ray, RayError, Triangle};
 use rdbvh_core::influence::{AreaError, InfluenceArea, PlaneArea, PointArea, RaySampler};
-use rdbvh_core::toplevel::{Scene, SceneOptions};
+use rdbvh_core::toplevel::{TopLevel, TopLevelOptions};
 use rdbvh_core::{BuildError, Vec3};
 use rdbvh_tests::{camera_rays, check_rays, check_structure, interior_rays, scene_bounds};
 
@@ -126,7 +126,7 @@ fn nan_and_infinite_coordinates_are_errors() {
         let e = Builder::sah().build(&tris).unwrap_err();
         assert_eq!(e, BuildError::InvalidPrimitive { index: 1 });
         assert!(e.to_string().contains("primitive 1"), "{e}");
-        let e = Scene::with_list(&tris, vec![], &SceneOptions::default()).unwrap_err();
+        let e = TopLevel::with_list(&tris, vec![], &TopLevelOptions::default()).unwrap_err();
         assert!(e.to_string().contains("primitive 1"), "{e}");
     }
 }
@@ -195,7 +195,7 @@ fn empty_scene_builds_an_empty_tree_that_hits_nothing() {
     assert_eq!(bvh.closest_hit(&ray, &[]), None);
     assert!(!bvh.any_hit(&ray, &[]));
     assert_eq!(bvh.all_hit(&ray, &[]).hits, 0);
-    let scene = Scene::with_octree(&[], vec![], &SceneOptions::default(), 5).unwrap();
+    let scene = TopLevel::with_octree(&[], vec![], &TopLevelOptions::default(), 5).unwrap();
     assert_eq!(scene.closest_hit(&ray, &[]), None);
 }
 
@@ -426,7 +426,7 @@ fn tmin_above_tmax_is_an_empty_segment_that_hits_nothing() {
     let area: InfluenceArea = PlaneArea::new(Vec3::new(0.0, 0.0, -1.0), Vec3::Z, 2.0, 2.0, 200.0)
         .unwrap()
         .into();
-    let scene = Scene::with_octree(&tris, vec![area], &SceneOptions::default(), 5).unwrap();
+    let scene = TopLevel::with_octree(&tris, vec![area], &TopLevelOptions::default(), 5).unwrap();
     for (t_min, t_max) in [(5.0, 4.0), (f32::INFINITY, 0.0), (0.0, f32::NEG_INFINITY)] {
         let ray = Ray::segment(Vec3::new(0.0, 0.0, -1.0), Vec3::Z, t_min, t_max).unwrap();
         assert!(area.is_affine(&ray) || t_min > 0.0 || t_max < 0.0);
@@ -456,8 +456,9 @@ fn scene_with_zero_areas_and_tiny_areas_uses_the_fallback() {
         .into();
     let rays = camera_rays(&scene_bounds(&tris), 300, 8);
     for areas in [vec![], vec![tiny]] {
-        let scene = Scene::with_octree(&tris, areas.clone(), &SceneOptions::default(), 5).unwrap();
-        let list = Scene::with_list(&tris, areas.clone(), &SceneOptions::default()).unwrap();
+        let scene =
+            TopLevel::with_octree(&tris, areas.clone(), &TopLevelOptions::default(), 5).unwrap();
+        let list = TopLevel::with_list(&tris, areas.clone(), &TopLevelOptions::default()).unwrap();
         let mut all = rays.clone();
         for a in &areas {
             all.extend(RaySampler::new(*a, 9).take(50));

@@ -9,10 +9,10 @@ use rdbvh_core::builder::Builder;
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::PerspectiveMeasure;
 use rdbvh_core::influence::{InfluenceArea, PointArea};
-use rdbvh_core::toplevel::{Scene, SceneOptions};
+use rdbvh_core::toplevel::{TopLevel, TopLevelOptions};
 use rdbvh_core::Vec3;
 
-/// Fixed (`scene` target): `Scene::triangles_in_area` dropped a triangle whose *exact* box
+/// Fixed (`scene` target): `TopLevel::triangles_in_area` dropped a triangle whose *exact* box
 /// misses the area's box before the (tolerant) separating-axis test, while BVH nodes store padded
 /// boxes. For a billion-unit triangle, Moller-Trumbore's rounding puts the hit 11.5 units outside
 /// the triangle's exact box (inside its padded box, so not `known_core_bug`): brute force and a
@@ -52,9 +52,9 @@ fn scene_prefilter_keeps_hits_outside_the_exact_box() {
             .closest_hit(&ray, &tris),
         expect
     );
-    let mut options = SceneOptions::default();
+    let mut options = TopLevelOptions::default();
     options.local.perspective = PerspectiveMeasure::ImagePlane;
-    let scene = Scene::with_octree(&tris, vec![area], &options, 1).unwrap();
+    let scene = TopLevel::with_octree(&tris, vec![area], &options, 1).unwrap();
     assert!(area.is_affine(&ray), "the ray must take the local path");
     assert_eq!(scene.closest_hit(&ray, &tris), expect);
 }

@@ -12,7 +12,7 @@ use rdbvh_core::brute_force;
 use rdbvh_core::builder::{Preset, ReinsertConfig};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::influence::{InfluenceArea, PlaneArea, PointArea, RaySampler};
-use rdbvh_core::toplevel::{Octree, Scene, SceneOptions};
+use rdbvh_core::toplevel::{Octree, TopLevel, TopLevelOptions};
 use rdbvh_core::Vec3;
 use rdbvh_tests::known_core_bug;
 
@@ -98,9 +98,9 @@ proptest! {
     ) {
         // Every tree reinserted (every node tried) or as built: the answers are the same.
         let reinsert = reinsert.then_some(ReinsertConfig { fraction: 1.0, ..ReinsertConfig::default() });
-        let options = SceneOptions { preset, max_tries, reinsert, ..SceneOptions::default() };
-        let octree = Scene::with_octree(&tris, areas.clone(), &options, 4).unwrap();
-        let list = Scene::with_list(&tris, areas.clone(), &options).unwrap();
+        let options = TopLevelOptions { preset, max_tries, reinsert, ..TopLevelOptions::default() };
+        let octree = TopLevel::with_octree(&tris, areas.clone(), &options, 4).unwrap();
+        let list = TopLevel::with_list(&tris, areas.clone(), &options).unwrap();
         let mut rng = rdbvh_tests::Rng::new(seed);
         for (i, a) in areas.iter().enumerate() {
             let mut sampler = RaySampler::new(*a, seed ^ i as u64);
@@ -152,7 +152,7 @@ fn crossing_triangle_and_hit_beyond_exit() {
         Vec3::new(0.0, 0.5, 2.001),
     );
     let tris = [beyond, crossing];
-    let scene = Scene::with_octree(&tris, vec![area], &SceneOptions::default(), 5).unwrap();
+    let scene = TopLevel::with_octree(&tris, vec![area], &TopLevelOptions::default(), 5).unwrap();
     assert_eq!(
         scene.triangles_per_area(),
         vec![1],

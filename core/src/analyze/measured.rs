@@ -3,7 +3,7 @@
 use crate::bvh::{AllHitStats, TraversalStats};
 use crate::geometry::{Ray, Triangle};
 use crate::heuristics::CostConstants;
-use crate::toplevel::{AreaLookup, Scene, SceneStats};
+use crate::toplevel::{AreaLookup, TopLevel, TopLevelStats};
 
 /// What the all-hit walk did through the structure for one ray.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -21,7 +21,7 @@ pub struct StructureAllHit {
 /// over `[t_min, t_exit]` with no early exit; if no triangle there is hit, the fallback BVH is
 /// walked over the rest of the segment.
 pub fn structure_all_hit<L: AreaLookup>(
-    scene: &Scene<L>,
+    scene: &TopLevel<L>,
     ray: &Ray,
     tris: &[Triangle],
 ) -> StructureAllHit {
@@ -122,7 +122,7 @@ impl RayCostSums {
     /// Traces `ray` every way and adds its costs under constants `k`.
     pub fn add<L: AreaLookup>(
         &mut self,
-        scene: &Scene<L>,
+        scene: &TopLevel<L>,
         ray: &Ray,
         tris: &[Triangle],
         k: CostConstants,
@@ -141,7 +141,7 @@ impl RayCostSums {
         }
         self.all_fallback_alone += f64::from(fallback.all_hit(ray, tris).cost(k));
 
-        let mut st = SceneStats::default();
+        let mut st = TopLevelStats::default();
         scene.closest_hit_with_stats(ray, tris, &mut st);
         self.closest_structure += f64::from(st.cost(k));
         self.closest_local += f64::from(st.local.cost(k));
@@ -152,7 +152,7 @@ impl RayCostSums {
         fallback.closest_hit_with_stats(ray, tris, &mut g);
         self.closest_fallback_alone += f64::from(g.cost(k));
 
-        let mut st = SceneStats::default();
+        let mut st = TopLevelStats::default();
         scene.any_hit_with_stats(ray, tris, &mut st);
         self.any_structure += f64::from(st.cost(k));
         let mut g = TraversalStats::default();
@@ -212,7 +212,7 @@ impl RayCostSums {
 mod tests {
     use super::*;
     use crate::influence::{InfluenceArea, PlaneArea};
-    use crate::toplevel::SceneOptions;
+    use crate::toplevel::TopLevelOptions;
     use alloc::vec;
     use glam::Vec3;
 
@@ -234,7 +234,7 @@ mod tests {
         let area: InfluenceArea = PlaneArea::new(Vec3::new(0.5, 0.5, 0.0), Vec3::Z, 0.5, 0.5, 2.0)
             .unwrap()
             .into();
-        let scene = Scene::with_list(&tris, vec![area], &SceneOptions::default()).unwrap();
+        let scene = TopLevel::with_list(&tris, vec![area], &TopLevelOptions::default()).unwrap();
         assert_eq!(scene.triangles_per_area(), &[2]);
         let k = CostConstants::default();
         let mut sums = RayCostSums::default();

@@ -1,5 +1,5 @@
 //! What a composite structure needs of a hierarchy: one trait over the binary and the 4-wide
-//! BVH, so a [`crate::toplevel::Scene`]'s local and fallback trees can be either, statically
+//! BVH, so a [`crate::toplevel::TopLevel`]'s local and fallback trees can be either, statically
 //! dispatched.
 
 use super::{Bvh, Hit, TraversalStats, WideBvh};

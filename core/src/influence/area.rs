@@ -60,7 +60,7 @@ impl InfluenceArea {
         self.polytope().clip_ray(ray).map(|(_, t1)| t1)
     }
 
-    /// The ids of the triangles of `tris` this area's local BVH holds ([`crate::toplevel::Scene`]
+    /// The ids of the triangles of `tris` this area's local BVH holds ([`crate::toplevel::TopLevel`]
     /// builds it over them): those [`InfluenceArea::takes_triangle`] takes, in id order.
     pub fn triangles_in<'a>(&'a self, tris: &'a [Triangle]) -> impl Iterator<Item = u32> + 'a {
         let bounds = self.bounds().padded();

@@ -16,7 +16,7 @@ use rdbvh_core::builder::Preset;
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::{CostConstants, Sah};
 use rdbvh_core::influence::{InfluenceArea, PlaneArea, RaySampler};
-use rdbvh_core::toplevel::{Scene as Structure, SceneOptions, DEFAULT_OCTREE_LEVELS};
+use rdbvh_core::toplevel::{TopLevel, TopLevelOptions, DEFAULT_OCTREE_LEVELS};
 use rdbvh_core::Vec3;
 
 use super::builder::{BuilderArgs, BuilderKind, BuiltBvh};
@@ -221,12 +221,12 @@ fn structure(out: &mut impl Write) -> Result<usize, CliError> {
     let w = |out: &mut dyn Write, text: String| writeln!(out, "{text}").map_err(CliError::Stdout);
     let (scene, _) = load_scene("builtin:room", None)?;
     let area = room_light_area()?;
-    let options = SceneOptions {
+    let options = TopLevelOptions {
         preset: Preset::Full,
-        ..SceneOptions::default()
+        ..TopLevelOptions::default()
     };
     let start = Instant::now();
-    let s = Structure::with_octree(
+    let s = TopLevel::with_octree(
         &scene.triangles,
         vec![area],
         &options,

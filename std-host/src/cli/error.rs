@@ -6,7 +6,7 @@ use std::io;
 use std::path::PathBuf;
 
 use rdbvh_core::builder::PresetError;
-use rdbvh_core::toplevel::SceneError as StructureError;
+use rdbvh_core::toplevel::TopLevelError;
 use rdbvh_core::BuildError;
 
 use super::rays::RaysError;
@@ -25,7 +25,7 @@ pub enum CliError {
     /// The area file is unusable.
     Areas(AreasError),
     /// The scene structure (local BVHs, lookup, fallback BVH) could not be built.
-    Structure(StructureError),
+    Structure(TopLevelError),
     /// The command line asks for something impossible that clap cannot see (a preset that needs
     /// an area without --areas): exit status 2, like clap's own usage errors.
     Usage(String),
@@ -107,8 +107,8 @@ impl From<AreasError> for CliError {
     }
 }
 
-impl From<StructureError> for CliError {
-    fn from(e: StructureError) -> Self {
+impl From<TopLevelError> for CliError {
+    fn from(e: TopLevelError) -> Self {
         CliError::Structure(e)
     }
 }

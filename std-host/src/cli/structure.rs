@@ -12,8 +12,7 @@ use rdbvh_core::bvh::{Bvh, TraversalStats};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::CostConstants;
 use rdbvh_core::toplevel::{
-    AreaList, AreaLookup, Octree, Scene as Structure, SceneOptions, SceneStats,
-    DEFAULT_OCTREE_LEVELS,
+    AreaList, AreaLookup, Octree, TopLevel, TopLevelOptions, TopLevelStats, DEFAULT_OCTREE_LEVELS,
 };
 
 use super::answers::{write_answers, Answers};
@@ -24,7 +23,7 @@ use super::{load_scene, CliError};
 use crate::parallel::build_scene;
 
 /// The preset of the local BVHs when `--preset` is not given: `pah`, the binned SAH builder
-/// pricing its cuts with the area's PAH ([`SceneOptions`]'s default too). Over the thesis's 48
+/// pricing its cuts with the area's PAH ([`TopLevelOptions`]'s default too). Over the thesis's 48
 /// configurations with published scenes (20,000 rays each), its local trees' closest-hit cost per
 /// ray is 0.98x the `sah` trees' (geometric mean; 0.69x to 1.32x), the thesis's `full` 1.07x
 /// (0.69x to 1.69x); any hit 0.99x and 1.04x (`benches/RESULTS.md`).
@@ -69,7 +68,7 @@ struct Tally {
 }
 
 impl Tally {
-    fn of(s: &SceneStats, k: CostConstants) -> Self {
+    fn of(s: &TopLevelStats, k: CostConstants) -> Self {
         Tally {
             affine: usize::from(s.tries > 0),
             local: usize::from(s.answered_by.is_some()),
@@ -89,7 +88,7 @@ impl Tally {
 /// Traces `rays` in parallel through `structure`, then through its fallback BVH alone, costing
 /// both with `k`.
 pub fn trace_structure<L: AreaLookup + Sync>(
-    structure: &Structure<L>,
+    structure: &TopLevel<L>,
     triangles: &[Triangle],
     rays: &[Ray],
     any_hit: bool,
@@ -100,7 +99,7 @@ pub fn trace_structure<L: AreaLookup + Sync>(
         let (hits, tallies): (Vec<bool>, Vec<Tally>) = rays
             .par_iter()
             .map(|r| {
-                let mut s = SceneStats::default();
+                let mut s = TopLevelStats::default();
                 let hit = structure.any_hit_with_stats(r, triangles, &mut s);
                 (hit, Tally::of(&s, k))
             })
@@ -110,7 +109,7 @@ pub fn trace_structure<L: AreaLookup + Sync>(
         let (hits, tallies): (Vec<_>, Vec<Tally>) = rays
             .par_iter()
             .map(|r| {
-                let mut s = SceneStats::default();
+                let mut s = TopLevelStats::default();
                 let hit = structure.closest_hit_with_stats(r, triangles, &mut s);
                 (hit, Tally::of(&s, k))
             })
@@ -163,8 +162,8 @@ fn fallback_alone(
 /// The scene-structure options of a command line: the local preset (`pah` unless --preset says
 /// otherwise) with --thesis-mode/--bins/--max-leaf, the fallback with the defaults, and with
 /// --reinsert every tree reinserted with the default settings.
-pub fn structure_options(args: &TraceArgs) -> SceneOptions {
-    SceneOptions {
+pub fn structure_options(args: &TraceArgs) -> TopLevelOptions {
+    TopLevelOptions {
         preset: args.builder.preset().unwrap_or(DEFAULT_LOCAL_PRESET),
         local: args.builder.preset_options(),
         fallback_preset: Preset::Sah,
@@ -229,7 +228,7 @@ fn finish<L: AreaLookup + Sync>(
     args: &TraceArgs,
     scene: &crate::scene::Scene,
     rays: &[Ray],
-    structure: &Structure<L>,
+    structure: &TopLevel<L>,
     lookup: &str,
     build_seconds: f64,
     log: &mut impl Write,

@@ -10,7 +10,7 @@ use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::CostConstants;
 use rdbvh_core::influence::{InfluenceArea, PointDistribution, RaySampler};
-use rdbvh_core::toplevel::{Octree, Scene};
+use rdbvh_core::toplevel::{Octree, TopLevel};
 
 use super::ExperimentError;
 use crate::clock::StdClock;
@@ -157,7 +157,7 @@ pub fn run_one(
 
     let octree = Octree::build(&[*area], setup.octree_levels);
     let octree_stats = octree.stats();
-    let scene = Scene::from_parts(vec![*area], vec![local], fallback.clone(), octree, 1)
+    let scene = TopLevel::from_parts(vec![*area], vec![local], fallback.clone(), octree, 1)
         .ok_or_else(|| ExperimentError::Build("structure: one local BVH per area".into()))?;
 
     let mut sums = RayCostSums::default();

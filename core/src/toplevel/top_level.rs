@@ -15,9 +15,9 @@ use crate::influence::InfluenceArea;
 /// at the boundary from falling between the two searches under rounding.
 const EXIT_OVERLAP: f32 = 1e-5;
 
-/// How a [`Scene`] is built.
+/// How a [`TopLevel`] is built.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SceneOptions {
+pub struct TopLevelOptions {
     /// The preset of every local BVH: `pah` by default (binned SAH pricing its cuts with the
     /// area's PAH), whose local trees cost less per ray on average than `sah`'s and the thesis's
     /// `full` (PAH + SPFH) over the thesis's configurations; `full` is costlier on architectural
@@ -37,7 +37,7 @@ pub struct SceneOptions {
     pub reinsert: Option<ReinsertConfig>,
 }
 
-impl Default for SceneOptions {
+impl Default for TopLevelOptions {
     fn default() -> Self {
         Self {
             preset: Preset::Pah,
@@ -50,15 +50,15 @@ impl Default for SceneOptions {
     }
 }
 
-impl SceneOptions {
-    /// Applies [`SceneOptions::reinsert`] to the local BVH built for `area`.
+impl TopLevelOptions {
+    /// Applies [`TopLevelOptions::reinsert`] to the local BVH built for `area`.
     pub fn reinsert_local(&self, area: &InfluenceArea, bvh: &mut Bvh) {
         if let Some(config) = &self.reinsert {
             self.preset.reinsert(Some(area), &self.local, bvh, config);
         }
     }
 
-    /// Applies [`SceneOptions::reinsert`] to the fallback BVH.
+    /// Applies [`TopLevelOptions::reinsert`] to the fallback BVH.
     pub fn reinsert_fallback(&self, bvh: &mut Bvh) {
         if let Some(config) = &self.reinsert {
             self.fallback_preset
@@ -69,7 +69,7 @@ impl SceneOptions {
 
 /// Why a scene could not be built.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SceneError {
+pub enum TopLevelError {
     /// A local BVH failed to build.
     Local {
         /// The area.
@@ -81,20 +81,20 @@ pub enum SceneError {
     Fallback(PresetError),
 }
 
-impl fmt::Display for SceneError {
+impl fmt::Display for TopLevelError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            SceneError::Local { area, error } => write!(f, "local BVH of area {area}: {error}"),
-            SceneError::Fallback(e) => write!(f, "fallback BVH: {e}"),
+            TopLevelError::Local { area, error } => write!(f, "local BVH of area {area}: {error}"),
+            TopLevelError::Fallback(e) => write!(f, "fallback BVH: {e}"),
         }
     }
 }
 
-impl core::error::Error for SceneError {}
+impl core::error::Error for TopLevelError {}
 
 /// What one query through the scene did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct SceneStats {
+pub struct TopLevelStats {
     /// Affine areas whose local BVH was traversed.
     pub tries: u32,
     /// The area whose local BVH answered, if one did.
@@ -107,7 +107,7 @@ pub struct SceneStats {
     pub fallback: TraversalStats,
 }
 
-impl SceneStats {
+impl TopLevelStats {
     /// Total cost: local plus fallback work.
     pub fn cost(&self, k: CostConstants) -> f32 {
         self.local.cost(k) + self.fallback.cost(k)
@@ -123,10 +123,10 @@ impl SceneStats {
 /// local BVH by the conservative separating-axis test of [`InfluenceArea::takes_triangle`]). Otherwise the
 /// fallback BVH answers the rest of the segment. Every answer equals the brute-force one.
 ///
-/// The trees `T` are binary [`Bvh`]s as built; [`Scene::widen`] turns every one into a
+/// The trees `T` are binary [`Bvh`]s as built; [`TopLevel::widen`] turns every one into a
 /// [`WideBvh`] (4-wide nodes, the faster traversal) with the same answers.
 #[derive(Clone, Debug)]
-pub struct Scene<L: AreaLookup = Octree, T: Traversable = Bvh> {
+pub struct TopLevel<L: AreaLookup = Octree, T: Traversable = Bvh> {
     areas: Vec<InfluenceArea>,
     local: Vec<T>,
     fallback: T,
@@ -134,41 +134,41 @@ pub struct Scene<L: AreaLookup = Octree, T: Traversable = Bvh> {
     max_tries: u32,
 }
 
-impl Scene<Octree> {
+impl TopLevel<Octree> {
     /// A scene over `tris` with an octree of `levels` levels.
     pub fn with_octree(
         tris: &[Triangle],
         areas: Vec<InfluenceArea>,
-        options: &SceneOptions,
+        options: &TopLevelOptions,
         levels: u32,
-    ) -> Result<Self, SceneError> {
+    ) -> Result<Self, TopLevelError> {
         Self::build(tris, areas, options, |a| Octree::build(a, levels))
     }
 }
 
-impl Scene<AreaList> {
+impl TopLevel<AreaList> {
     /// A scene over `tris` with the naive area list.
     pub fn with_list(
         tris: &[Triangle],
         areas: Vec<InfluenceArea>,
-        options: &SceneOptions,
-    ) -> Result<Self, SceneError> {
+        options: &TopLevelOptions,
+    ) -> Result<Self, TopLevelError> {
         Self::build(tris, areas, options, |a| AreaList::new(a.len()))
     }
 }
 
-impl<L: AreaLookup> Scene<L> {
+impl<L: AreaLookup> TopLevel<L> {
     /// Builds the local BVHs (one arena for all), the fallback BVH and the lookup.
     pub fn build(
         tris: &[Triangle],
         areas: Vec<InfluenceArea>,
-        options: &SceneOptions,
+        options: &TopLevelOptions,
         lookup: impl FnOnce(&[InfluenceArea]) -> L,
-    ) -> Result<Self, SceneError> {
+    ) -> Result<Self, TopLevelError> {
         let mut arena = BuildArena::with_capacity(tris.len());
         let mut local = Vec::with_capacity(areas.len());
         for (i, area) in areas.iter().enumerate() {
-            let fail = |error| SceneError::Local {
+            let fail = |error| TopLevelError::Local {
                 area: i as u32,
                 error,
             };
@@ -185,12 +185,12 @@ impl<L: AreaLookup> Scene<L> {
         }
         arena
             .load_triangles(tris)
-            .map_err(|e| SceneError::Fallback(e.into()))?;
+            .map_err(|e| TopLevelError::Fallback(e.into()))?;
         let mut fallback = Bvh::with_capacity(tris.len());
         options
             .fallback_preset
             .build_into(None, &options.fallback, &mut arena, &mut fallback)
-            .map_err(SceneError::Fallback)?;
+            .map_err(TopLevelError::Fallback)?;
         options.reinsert_fallback(&mut fallback);
         let lookup = lookup(&areas);
         Ok(Self {
@@ -205,8 +205,8 @@ impl<L: AreaLookup> Scene<L> {
     /// The same scene with every local and the fallback BVH collapsed to 4-wide nodes
     /// ([`WideBvh::from_binary`], each with its own copy of its triangles from `tris`, the array
     /// the scene was built over): same areas, lookup and answers, faster queries.
-    pub fn widen(self, tris: &[Triangle]) -> Scene<L, WideBvh> {
-        Scene {
+    pub fn widen(self, tris: &[Triangle]) -> TopLevel<L, WideBvh> {
+        TopLevel {
             areas: self.areas,
             local: self
                 .local
@@ -220,10 +220,10 @@ impl<L: AreaLookup> Scene<L> {
     }
 }
 
-impl<L: AreaLookup, T: Traversable> Scene<L, T> {
+impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
     /// Assembles a scene from parts built elsewhere (a threaded host builds the local BVHs in
     /// parallel). `None` unless there is one local BVH per area. The caller vouches that each
-    /// local BVH holds every triangle overlapping its area (as [`Scene::build`] selects them):
+    /// local BVH holds every triangle overlapping its area (as [`TopLevel::build`] selects them):
     /// the exactness of the queries rests on it.
     pub fn from_parts(
         areas: Vec<InfluenceArea>,
@@ -303,15 +303,15 @@ impl<L: AreaLookup, T: Traversable> Scene<L, T> {
 
     /// The closest hit, exactly as brute force finds it.
     pub fn closest_hit(&self, ray: &Ray, tris: &[Triangle]) -> Option<Hit> {
-        self.closest_hit_with_stats(ray, tris, &mut SceneStats::default())
+        self.closest_hit_with_stats(ray, tris, &mut TopLevelStats::default())
     }
 
-    /// [`Scene::closest_hit`], recording what it did in `stats`.
+    /// [`TopLevel::closest_hit`], recording what it did in `stats`.
     pub fn closest_hit_with_stats(
         &self,
         ray: &Ray,
         tris: &[Triangle],
-        stats: &mut SceneStats,
+        stats: &mut TopLevelStats,
     ) -> Option<Hit> {
         let mut searched_to = ray.t_min;
         for (a, t_exit) in self.affine_segments(ray) {
@@ -339,11 +339,16 @@ impl<L: AreaLookup, T: Traversable> Scene<L, T> {
 
     /// True when anything is hit on the segment, exactly as brute force says.
     pub fn any_hit(&self, ray: &Ray, tris: &[Triangle]) -> bool {
-        self.any_hit_with_stats(ray, tris, &mut SceneStats::default())
+        self.any_hit_with_stats(ray, tris, &mut TopLevelStats::default())
     }
 
-    /// [`Scene::any_hit`], recording what it did in `stats`.
-    pub fn any_hit_with_stats(&self, ray: &Ray, tris: &[Triangle], stats: &mut SceneStats) -> bool {
+    /// [`TopLevel::any_hit`], recording what it did in `stats`.
+    pub fn any_hit_with_stats(
+        &self,
+        ray: &Ray,
+        tris: &[Triangle],
+        stats: &mut TopLevelStats,
+    ) -> bool {
         let mut searched_to = ray.t_min;
         for (a, t_exit) in self.affine_segments(ray) {
             stats.tries += 1;
@@ -383,7 +388,7 @@ impl<L: AreaLookup, T: Traversable> Scene<L, T> {
         let (mut hits, mut local, mut global, mut structure) = (0u32, 0f64, 0f64, 0f64);
         for ray in rays {
             out.rays += 1;
-            let mut s = SceneStats::default();
+            let mut s = TopLevelStats::default();
             self.closest_hit_with_stats(&ray, tris, &mut s);
             if s.answered_by == Some(area as u32) {
                 hits += 1;
@@ -454,9 +459,9 @@ mod tests {
     #[test]
     fn queries_equal_brute_force_for_affine_and_other_rays() {
         let tris = soup(800, 2);
-        let options = SceneOptions::default();
-        let octree = Scene::with_octree(&tris, areas(), &options, 5).unwrap();
-        let list = Scene::with_list(&tris, areas(), &options).unwrap();
+        let options = TopLevelOptions::default();
+        let octree = TopLevel::with_octree(&tris, areas(), &options, 5).unwrap();
+        let list = TopLevel::with_list(&tris, areas(), &options).unwrap();
         let wide = octree.clone().widen(&tris);
         assert_eq!(wide.triangles_per_area(), octree.triangles_per_area());
         let mut rng = Pcg32::new(4);
@@ -480,10 +485,10 @@ mod tests {
                     ray = r;
                 }
                 let expect = brute_force::closest_hit(&ray, &tris);
-                let mut s = SceneStats::default();
+                let mut s = TopLevelStats::default();
                 assert_eq!(octree.closest_hit_with_stats(&ray, &tris, &mut s), expect);
                 local_answers += usize::from(s.answered_by.is_some());
-                let mut w = SceneStats::default();
+                let mut w = TopLevelStats::default();
                 assert_eq!(wide.closest_hit_with_stats(&ray, &tris, &mut w), expect);
                 wide_local_answers += usize::from(w.answered_by.is_some());
                 assert_eq!(wide.any_hit(&ray, &tris), expect.is_some());
@@ -513,8 +518,8 @@ mod tests {
             Vec3::new(0.0, 1.0, -0.5),
         );
         let tris = [behind];
-        let scene =
-            Scene::with_octree(&tris, alloc::vec![area], &SceneOptions::default(), 5).unwrap();
+        let scene = TopLevel::with_octree(&tris, alloc::vec![area], &TopLevelOptions::default(), 5)
+            .unwrap();
         let ray = Ray::segment(
             Vec3::new(0.1, 0.1, 0.5),
             Vec3::Z,
@@ -528,7 +533,7 @@ mod tests {
         assert!(scene.any_hit(&ray, &tris));
         // From t_min = 0 the same ray is affine, answered locally, and misses.
         let forward = Ray::new(Vec3::new(0.1, 0.1, 0.5), Vec3::Z).unwrap();
-        let mut stats = SceneStats::default();
+        let mut stats = TopLevelStats::default();
         assert_eq!(
             scene.closest_hit_with_stats(&forward, &tris, &mut stats),
             None
@@ -539,7 +544,8 @@ mod tests {
     #[test]
     fn break_even_and_retain() {
         let tris = soup(800, 3);
-        let mut scene = Scene::with_octree(&tris, areas(), &SceneOptions::default(), 5).unwrap();
+        let mut scene =
+            TopLevel::with_octree(&tris, areas(), &TopLevelOptions::default(), 5).unwrap();
         let rays: Vec<Ray> = RaySampler::new(scene.areas()[0], 1).take(2000).collect();
         let k = CostConstants::default();
         assert_eq!(scene.break_even(2, rays.iter().copied(), &tris, k), None);

@@ -127,13 +127,15 @@ pub fn render() -> String {
          light buffer per light (a cube map of directions around it, each cell holding a BVH of\n\
          what segments toward the light through that cell can hit; emissive triangles are\n\
          clustered per material, at most 32 buffers, for the most powerful lights), with the\n\
-         global BVH for segments a buffer does not take. Both answer exactly as the global BVH\n\
-         does: the images are byte-identical.\n\
+         global BVH for segments a buffer does not take. A pilot frame (1/8 of the resolution,\n\
+         1 sample) then keeps a buffer only where its shadow segments need at most 0.7 of the\n\
+         global BVH's node + triangle tests; build_ms includes it. Both structures answer exactly\n\
+         as the global BVH does: the images are byte-identical.\n\
          shadow_ms is the best of --shadow-replays single-thread replays of the frame's shadow\n\
          segments (its first 2097152 when it has more) through the structure alone, without\n\
          counters; the replay's answers must equal the frame's.\n\
          --json prints one object as the last line, with the keys scene, triangles, lights,\n\
-         light_buffers, width, height, spp, max_bounces, seed, threads, structure, build_ms,\n\
+         light_buffers, light_buffers_dropped, pilot_shadow_rays, width, height, spp, max_bounces, seed, threads, structure, build_ms,\n\
          render_ms, camera_rays, shadow_rays, bounce_rays, shadow_occluded, shadow_node_tests,\n\
          shadow_triangle_tests, shadow_replay_rays, shadow_ms, mean_luminance and out.\n\
          --record-rays DIR writes the first --record-limit rays of each kind (in tile order, then\n\

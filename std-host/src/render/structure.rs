@@ -115,11 +115,8 @@ impl Structure {
                 next += 1;
             }
         }
-        let mut b = 0;
-        self.buffers.retain(|_| {
-            b += 1;
-            keep[b - 1]
-        });
+        let mut keeps = keep.iter();
+        self.buffers.retain(|_| keeps.next() == Some(&true));
         for slot in &mut self.buffer_of {
             if *slot != NO_BUFFER {
                 *slot = new_index[*slot as usize];

@@ -24,7 +24,9 @@ use criterion::{
 use rdbvh_benches::compare::{plane_area_over, point_area_over};
 use rdbvh_benches::peers::{BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Rdbvh, RdbvhWide};
 use rdbvh_benches::{bounds, load_scene, single_thread_pool, RdbvhReuse, BENCH_SCENES};
-use rdbvh_core::builder::{BuildArena, Builder, Preset, PresetOptions, ReinsertConfig, Reinserter};
+use rdbvh_core::builder::{
+    BuildArena, BuildOptions, Builder, Preset, PresetOptions, ReinsertConfig, Reinserter,
+};
 use rdbvh_core::bvh::{Bvh, WideBvh};
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::heuristics::Sah;
@@ -123,8 +125,8 @@ fn builds(c: &mut Criterion<Clock>) {
             group.bench_function(*id, |bench| {
                 bench.iter(|| {
                     arena.load_triangles(&tris).expect("finite triangles");
-                    preset
-                        .build_into(area.as_ref(), &options, &mut arena, &mut out)
+                    BuildOptions::with_settings(*preset, options)
+                        .build_into(&mut arena, area.as_ref(), &mut out)
                         .expect("valid preset")
                         .nodes
                 })

@@ -19,7 +19,7 @@ use clock::Clock;
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use rdbvh_benches::areas::{plane_area_facing, point_area_facing};
 use rdbvh_benches::{bounds, load_scene, BENCH_SCENES};
-use rdbvh_core::builder::{BuildArena, Preset, PresetOptions};
+use rdbvh_core::builder::{BuildArena, BuildOptions, Preset, PresetOptions};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::influence::InfluenceArea;
 
@@ -67,8 +67,8 @@ fn presets(c: &mut Criterion<Clock>) {
                     arena
                         .load_triangles(black_box(&tris))
                         .expect("finite triangles");
-                    preset
-                        .build_into(area.as_ref(), &options, &mut arena, &mut out)
+                    BuildOptions::with_settings(*preset, options)
+                        .build_into(&mut arena, area.as_ref(), &mut out)
                         .expect("valid preset")
                         .nodes
                 })

@@ -28,7 +28,7 @@ use std::fmt::Write as _;
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use rdbvh_core::builder::{BuildArena, Builder, Preset, PresetOptions};
+use rdbvh_core::builder::{BuildArena, BuildOptions, Builder, Preset, PresetOptions};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 use rdbvh_core::influence::{InfluenceArea, PlaneArea, PointArea};
@@ -492,13 +492,8 @@ impl<'a> PahReps<'a> {
             .load_triangles(self.tris)
             .map_err(|e| e.to_string())
             .and_then(|_| {
-                preset
-                    .build_into(
-                        area,
-                        &PresetOptions::default(),
-                        &mut self.arena,
-                        &mut self.bvh,
-                    )
+                BuildOptions::with_settings(preset, PresetOptions::default())
+                    .build_into(&mut self.arena, area, &mut self.bvh)
                     .map(|_| ())
                     .map_err(|e| e.to_string())
             })
@@ -634,7 +629,7 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
     })
 }
 
-/// The top of `rdbvh::parallel::build` (the tree down to its job cutoff, the same rule: 4 jobs
+/// The top of `rdbvh_core::builder::parallel::build` (the tree down to its job cutoff, the same rule: 4 jobs
 /// per thread, at least 2048 primitives) run on one thread, then the whole one-thread build.
 struct SerialTop<'a> {
     tris: &'a [Triangle],

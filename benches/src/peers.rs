@@ -135,8 +135,9 @@ pub struct Rdbvh;
 
 impl Library for Rdbvh {
     const NAME: &'static str = "rdbvh";
-    const PARALLEL_BUILD: Option<&'static str> =
-        Some("rdbvh::parallel::build (rayon; the single-threaded tree, node for node)");
+    const PARALLEL_BUILD: Option<&'static str> = Some(
+        "rdbvh_core::builder::parallel::build (rayon; the single-threaded tree, node for node)",
+    );
     type Scene = Vec<Triangle>;
     type Ray = Ray;
     type Accel = rdbvh_core::bvh::Bvh;
@@ -153,7 +154,8 @@ impl Library for Rdbvh {
             .expect("scene triangles are finite")
     }
     fn build_mt(scene: &mut Self::Scene) -> Self::Accel {
-        rdbvh::parallel::build(&Builder::sah(), scene).expect("scene triangles are finite")
+        rdbvh_core::builder::parallel::build(&Builder::sah(), scene)
+            .expect("scene triangles are finite")
     }
     #[inline]
     fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Ray) -> Option<f32> {
@@ -175,7 +177,7 @@ pub struct RdbvhWide;
 impl Library for RdbvhWide {
     const NAME: &'static str = "rdbvh-wide";
     const PARALLEL_BUILD: Option<&'static str> =
-        Some("rdbvh::parallel::build, then the single-threaded reinsertion and 4-wide collapse");
+        Some("rdbvh_core::builder::parallel::build, then the single-threaded reinsertion and 4-wide collapse");
     type Scene = Vec<Triangle>;
     type Ray = Ray;
     type Accel = rdbvh_core::bvh::WideBvh;

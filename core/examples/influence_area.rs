@@ -76,8 +76,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     println!(
         "room: {} triangles; built in {build_ms:.1} ms (local preset {}, fallback {})",
         tris.len(),
-        options.preset,
-        options.fallback_preset
+        options.local.preset,
+        options.fallback.preset
     );
     println!(
         "octree: {} levels, {} nodes, {} leaves, {} area references, {} bytes",

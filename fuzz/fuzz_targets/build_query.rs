@@ -5,7 +5,9 @@
 
 use arbitrary::{Result, Unstructured};
 use libfuzzer_sys::fuzz_target;
-use rdbvh_core::builder::{reinsert, BuildArena, Builder, Preset, ReinsertConfig};
+use rdbvh_core::builder::{
+    reinsert, BuildArena, BuildOptions, Builder, Preset, ReinsertConfig,
+};
 use rdbvh_core::bvh::{Bvh, WideBvh, MAX_DEPTH};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::{CostConstants, Sah};
@@ -73,7 +75,7 @@ fn run(u: &mut Unstructured) -> Result<()> {
         for preset in Preset::ALL {
             let mut bvh = Bvh::with_capacity(tris.len());
             let area: Option<&InfluenceArea> = Some(&area);
-            let stats = preset.build_into(area, &options, &mut arena, &mut bvh);
+            let stats = BuildOptions::with_settings(preset, options).build_into(&mut arena, area, &mut bvh);
             if let Err(e) = stats {
                 panic!(
                     "preset {preset} {options:?} over {} triangles: {e}",

@@ -6,7 +6,7 @@
 use arbitrary::{Result, Unstructured};
 use libfuzzer_sys::fuzz_target;
 use rdbvh_core::brute_force;
-use rdbvh_core::builder::Preset;
+use rdbvh_core::builder::{BuildOptions, Preset};
 use rdbvh_core::geometry::Ray;
 use rdbvh_core::influence::{PointDistribution, RaySampler};
 use rdbvh_core::toplevel::{AreaLookup, Octree, TopLevel, TopLevelOptions};
@@ -28,9 +28,8 @@ fn run(u: &mut Unstructured) -> Result<()> {
         }
     }
     let options = TopLevelOptions {
-        preset: *u.choose(&Preset::ALL)?,
-        local: preset_options(u)?,
-        fallback: preset_options(u)?,
+        local: BuildOptions::with_settings(*u.choose(&Preset::ALL)?, preset_options(u)?),
+        fallback: BuildOptions::with_settings(Preset::Sah, preset_options(u)?),
         max_tries: u.int_in_range(0..=3)?,
         ..TopLevelOptions::default()
     };

@@ -11,7 +11,6 @@ pub mod areas;
 pub mod cli;
 pub mod clock;
 pub mod experiment;
-pub mod parallel;
 pub mod render;
 pub mod same_file;
 pub mod scene;

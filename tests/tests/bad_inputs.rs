@@ -7,7 +7,7 @@ use std::path::Path;
 
 use rdbvh::scene::{MaterialFiles, Scene as ObjScene, SceneError as ObjError};
 use rdbvh_core::brute_force;
-use rdbvh_core::builder::{BuildArena, BuildConfig, Builder, Preset, PresetOptions};
+use rdbvh_core::builder::{BuildArena, BuildConfig, BuildOptions, Builder, Preset, PresetOptions};
 use rdbvh_core::bvh::{Bvh, WideBvh};
 use rdbvh_core::geometry::{Ray, RayError, Triangle};
 use rdbvh_core::influence::{AreaError, InfluenceArea, PlaneArea, PointArea, RaySampler};
@@ -170,8 +170,8 @@ fn every_build_agrees(tris: &[Triangle], rays: &[Ray]) {
             let mut arena = BuildArena::with_capacity(tris.len());
             arena.load_triangles(tris).unwrap();
             let mut bvh = Bvh::with_capacity(tris.len());
-            preset
-                .build_into(Some(&area), &options, &mut arena, &mut bvh)
+            BuildOptions::with_settings(preset, options)
+                .build_into(&mut arena, Some(&area), &mut bvh)
                 .unwrap();
             trees.push(bvh);
         }

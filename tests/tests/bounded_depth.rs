@@ -4,7 +4,8 @@
 //! validated and queried against brute force, which exercises those stacks at the deepest level.
 
 use rdbvh_core::builder::{
-    BinSpace, BuildArena, BuildConfig, Builder, CutEvaluation, Preset, PresetOptions, ThesisCut,
+    BinSpace, BuildArena, BuildConfig, BuildOptions, Builder, CutEvaluation, Preset, PresetOptions,
+    ThesisCut,
 };
 use rdbvh_core::bvh::{Bvh, WideBvh, MAX_DEPTH};
 use rdbvh_core::geometry::{Ray, Triangle};
@@ -172,8 +173,8 @@ fn every_build_of_adversarial_inputs_stays_within_the_depth_bound() {
                     let mut arena = BuildArena::with_capacity(tris.len());
                     arena.load_triangles(&tris).unwrap();
                     let mut bvh = Bvh::with_capacity(tris.len());
-                    preset
-                        .build_into(Some(area), &options, &mut arena, &mut bvh)
+                    BuildOptions::with_settings(preset, options)
+                        .build_into(&mut arena, Some(area), &mut bvh)
                         .unwrap();
                     deepest = deepest.max(bvh.max_depth());
                     let what = format!("{preset} thesis_mode={}", options.thesis_mode);

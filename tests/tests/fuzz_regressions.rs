@@ -53,7 +53,7 @@ fn scene_prefilter_keeps_hits_outside_the_exact_box() {
         expect
     );
     let mut options = TopLevelOptions::default();
-    options.local.perspective = PerspectiveMeasure::ImagePlane;
+    options.local.settings.perspective = PerspectiveMeasure::ImagePlane;
     let scene = TopLevel::with_octree(&tris, vec![area], &options, 1).unwrap();
     assert!(area.is_affine(&ray), "the ray must take the local path");
     assert_eq!(scene.closest_hit(&ray, &tris), expect);

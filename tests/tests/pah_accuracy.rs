@@ -6,9 +6,10 @@
 
 use rdbvh::areas::read_areas;
 use rdbvh::scene::Scene;
-use rdbvh_core::builder::{AreaPah, BuildArena, Preset, PresetOptions};
+use rdbvh_core::builder::{BuildArena, BuildOptions, Preset, PresetOptions};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
+use rdbvh_core::heuristics::AreaPah;
 use rdbvh_core::heuristics::{PerspectiveMeasure, Sah};
 use rdbvh_core::influence::{InfluenceArea, PointArea, PointDistribution, RaySampler};
 use rdbvh_tests::require_shared;
@@ -23,8 +24,8 @@ fn local_bvh(tris: &[Triangle], area: &InfluenceArea, preset: Preset, o: &Preset
         .load_triangle_subset(tris, area.triangles_in(tris))
         .unwrap();
     let mut bvh = Bvh::with_capacity(arena.len());
-    preset
-        .build_into(Some(area), o, &mut arena, &mut bvh)
+    BuildOptions::with_settings(preset, *o)
+        .build_into(&mut arena, Some(area), &mut bvh)
         .unwrap();
     bvh
 }

@@ -9,7 +9,7 @@
 
 use proptest::prelude::*;
 use rdbvh_core::brute_force;
-use rdbvh_core::builder::{Preset, ReinsertConfig};
+use rdbvh_core::builder::{BuildOptions, Preset, ReinsertConfig};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::influence::{InfluenceArea, PlaneArea, PointArea, RaySampler};
 use rdbvh_core::toplevel::{Octree, TopLevel, TopLevelOptions};
@@ -98,7 +98,12 @@ proptest! {
     ) {
         // Every tree reinserted (every node tried) or as built: the answers are the same.
         let reinsert = reinsert.then_some(ReinsertConfig { fraction: 1.0, ..ReinsertConfig::default() });
-        let options = TopLevelOptions { preset, max_tries, reinsert, ..TopLevelOptions::default() };
+        let options = TopLevelOptions {
+            local: BuildOptions::new(preset),
+            max_tries,
+            ..TopLevelOptions::default()
+        }
+        .reinsert(reinsert);
         let octree = TopLevel::with_octree(&tris, areas.clone(), &options, 4).unwrap();
         let list = TopLevel::with_list(&tris, areas.clone(), &options).unwrap();
         let mut rng = rdbvh_tests::Rng::new(seed);

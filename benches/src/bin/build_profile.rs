@@ -26,9 +26,10 @@ use std::time::Instant;
 
 use rdbvh_benches::compare::{plane_area_over, point_area_over};
 use rdbvh_benches::{load_scene, thread_cpu_seconds};
-use rdbvh_core::builder::{AreaPah, BuildArena, Builder, Preset, PresetError, PresetOptions};
+use rdbvh_core::builder::{BuildArena, BuildOptions, Builder, Preset, PresetError, PresetOptions};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
+use rdbvh_core::heuristics::AreaPah;
 use rdbvh_core::heuristics::{CostConstants, Sah};
 use rdbvh_core::influence::InfluenceArea;
 
@@ -41,7 +42,7 @@ fn build_once(tris: &[Triangle]) -> Bvh {
 /// One threaded build on the current rayon pool.
 #[inline(never)]
 fn build_mt_once(tris: &[Triangle]) -> Bvh {
-    rdbvh::parallel::build(&Builder::sah(), black_box(tris)).expect("finite scene")
+    rdbvh_core::builder::parallel::build(&Builder::sah(), black_box(tris)).expect("finite scene")
 }
 
 /// One timed build of `preset` over `area`: loading the bounds and the preset's build.
@@ -54,8 +55,8 @@ fn pah_once(
     out: &mut Bvh,
 ) -> Result<(), PresetError> {
     arena.load_triangles(black_box(tris)).expect("finite");
-    preset
-        .build_into(Some(area), &PresetOptions::default(), arena, out)
+    BuildOptions::with_settings(preset, PresetOptions::default())
+        .build_into(arena, Some(area), out)
         .map(|_| ())
 }
 

@@ -2,20 +2,14 @@
 
 use core::fmt;
 
-use super::{
-    reinsert, BinSpace, BuildArena, BuildConfig, BuildStats, Builder, Clock, CutEvaluation,
-    NoClock, ReinsertConfig, ReinsertStats, ThesisCut,
-};
-use crate::bvh::{Bvh, MAX_DEPTH};
-use crate::geometry::Aabb;
+use super::{BinSpace, BuildConfig, Builder, CutEvaluation, ThesisCut};
+use crate::bvh::MAX_DEPTH;
 use crate::heuristics::{
     AllAxes, AxisChooser, CostConstants, CostModel, LeafSize, LongestAxis, PahOrtho,
     PahPerspective, PerspectiveMeasure, Sah, SahTermination, Spfh, Termination,
 };
 use crate::influence::InfluenceArea;
-use crate::simd::Aabb4;
 use crate::BuildError;
-use wide::f32x4;
 
 /// A named builder. The thesis's four pairs plus binned SAH and binned PAH over all axes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -205,137 +199,10 @@ impl From<BuildError> for PresetError {
     }
 }
 
-/// PAH for an influence area: orthographic for a plane area, perspective for a point area. For
-/// estimating a built tree's cost (the builders themselves are monomorphised per kind).
-// The perspective model carries its 4-wide constants (about 600 bytes): one value per build or
-// estimate lives on the stack, and boxing it would allocate where builds promise not to.
-#[allow(clippy::large_enum_variant)]
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum AreaPah {
-    /// Parallel rays.
-    Ortho(PahOrtho),
-    /// Radial rays.
-    Perspective(PahPerspective),
-}
-
-impl AreaPah {
-    /// The PAH of `area`, culled to its window.
-    pub fn new(area: &InfluenceArea, perspective: PerspectiveMeasure) -> Self {
-        match area {
-            InfluenceArea::Plane(a) => AreaPah::Ortho(PahOrtho::for_area(a)),
-            InfluenceArea::Point(a) => {
-                AreaPah::Perspective(PahPerspective::for_area(a, perspective))
-            }
-        }
-    }
-
-    /// The measure of the whole window: every sampled ray starts in it, so a box's measure over
-    /// this is its hit probability.
-    pub fn window_measure(&self) -> f32 {
-        match self {
-            AreaPah::Ortho(p) => p.window_measure().unwrap_or(0.0),
-            AreaPah::Perspective(p) => p.window_measure(),
-        }
-    }
-}
-
-impl CostModel for AreaPah {
-    fn measure(&self, b: &Aabb) -> f32 {
-        match self {
-            AreaPah::Ortho(p) => p.measure(b),
-            AreaPah::Perspective(p) => p.measure(b),
-        }
-    }
-
-    /// Forwarded so the sweeps get each model's 4-wide evaluation, not four scalar calls.
-    #[inline]
-    fn measure4(&self, b: &Aabb4) -> f32x4 {
-        match self {
-            AreaPah::Ortho(p) => p.measure4(b),
-            AreaPah::Perspective(p) => p.measure4(b),
-        }
-    }
-
-    #[inline]
-    fn hint(&self, node: &Aabb) -> u32 {
-        match self {
-            AreaPah::Ortho(p) => p.hint(node),
-            AreaPah::Perspective(p) => p.hint(node),
-        }
-    }
-
-    #[inline]
-    fn measure4_hinted(&self, b: &Aabb4, hint: u32) -> f32x4 {
-        match self {
-            AreaPah::Ortho(p) => p.measure4_hinted(b, hint),
-            AreaPah::Perspective(p) => p.measure4_hinted(b, hint),
-        }
-    }
-}
-
 impl Preset {
-    /// Improves `bvh`, built with this preset (for `area` when it needs one), by reinsertion
-    /// under the preset's own cost model: the area's PAH (with `options.perspective`) for the PAH
-    /// presets, SAH for the others, so the tree stays good where the preset's rays go.
-    pub fn reinsert(
-        self,
-        area: Option<&InfluenceArea>,
-        options: &PresetOptions,
-        bvh: &mut Bvh,
-        config: &ReinsertConfig,
-    ) -> ReinsertStats {
-        match area {
-            Some(a) if self.uses_pah() => {
-                reinsert(bvh, &AreaPah::new(a, options.perspective), config)
-            }
-            _ => reinsert(bvh, &Sah, config),
-        }
-    }
-
-    /// Builds the arena's primitives with this preset into `out`. `area` is required for
-    /// `facing`, `longest`, `full` and `pah`, ignored by `sah` and `standard`.
-    pub fn build_into(
-        self,
-        area: Option<&InfluenceArea>,
-        options: &PresetOptions,
-        arena: &mut BuildArena,
-        out: &mut Bvh,
-    ) -> Result<BuildStats, PresetError> {
-        self.build_into_profiled(area, options, arena, out, &NoClock)
-    }
-
-    /// [`Preset::build_into`], timing its phases with `clock` into [`BuildStats::profile`].
-    pub fn build_into_profiled(
-        self,
-        area: Option<&InfluenceArea>,
-        options: &PresetOptions,
-        arena: &mut BuildArena,
-        out: &mut Bvh,
-        clock: &impl Clock,
-    ) -> Result<BuildStats, PresetError> {
-        /// Builds into the caller's arena and tree.
-        struct IntoArena<'a, K> {
-            arena: &'a mut BuildArena,
-            out: &'a mut Bvh,
-            clock: &'a K,
-        }
-        impl<K: Clock> PresetVisitor for IntoArena<'_, K> {
-            type Output = Result<BuildStats, BuildError>;
-            fn visit<A, C, T>(self, builder: Builder<A, C, T>) -> Self::Output
-            where
-                A: AxisChooser + Send + Sync,
-                C: CostModel + Send + Sync,
-                T: Termination + Send + Sync,
-            {
-                builder.build_into_profiled(self.arena, self.out, self.clock)
-            }
-        }
-        Ok(self.with_builder(area, options, IntoArena { arena, out, clock })??)
-    }
-
     /// Hands `visitor` the builder this preset names for `area` and `options`, statically
-    /// dispatched: how a host runs a preset its own way (`rdbvh::parallel` builds it on every
-    /// thread) without a second copy of which chooser, cost model and termination each preset
+    /// dispatched: how [`super::BuildOptions`] runs a preset on one thread or on every thread,
+    /// and how a caller runs one its own way, without a second copy of which chooser, cost model and termination each preset
     /// takes. `area` is required for `facing`, `longest`, `full` and `pah`.
     pub fn with_builder<V: PresetVisitor>(
         self,
@@ -464,7 +331,10 @@ mod tests {
 
     use super::*;
     use crate::brute_force;
+    use crate::builder::{BuildArena, BuildOptions};
+    use crate::bvh::Bvh;
     use crate::geometry::Triangle;
+    use crate::heuristics::AreaPah;
     use crate::influence::{PlaneArea, PointArea, RaySampler};
 
     fn soup(n: usize) -> Vec<Triangle> {
@@ -501,8 +371,8 @@ mod tests {
                     let mut arena = BuildArena::with_capacity(tris.len());
                     arena.load_triangles(&tris).unwrap();
                     let mut bvh = Bvh::with_capacity(tris.len());
-                    preset
-                        .build_into(Some(area), &options, &mut arena, &mut bvh)
+                    BuildOptions::with_settings(preset, options)
+                        .build_into(&mut arena, Some(area), &mut bvh)
                         .unwrap();
                     bvh.validate(tris.len(), |i| tris[i as usize].bounds())
                         .unwrap();
@@ -555,18 +425,17 @@ mod tests {
             let mut arena = BuildArena::with_capacity(tris.len());
             arena.load_triangles(&tris).unwrap();
             let mut bvh = Bvh::with_capacity(tris.len());
-            Preset::Pah
-                .build_into(Some(area), &o, &mut arena, &mut bvh)
+            BuildOptions::with_settings(Preset::Pah, o)
+                .build_into(&mut arena, Some(area), &mut bvh)
                 .unwrap();
             assert_eq!(bvh, expected.unwrap());
             // And the model changed the tree: it is not `sah`'s.
             assert_ne!(bvh, sah);
         }
         assert_eq!(
-            Preset::Pah.build_into(
-                None,
-                &o,
+            BuildOptions::with_settings(Preset::Pah, o).build_into(
                 &mut BuildArena::with_capacity(1),
+                None,
                 &mut Bvh::default()
             ),
             Err(PresetError::NeedsArea(Preset::Pah))
@@ -608,8 +477,8 @@ mod tests {
                 .unwrap();
             let mut bvh = Bvh::with_capacity(tris.len());
             let o = PresetOptions::thesis();
-            Preset::Full
-                .build_into(Some(area), &o, &mut arena, &mut bvh)
+            BuildOptions::with_settings(Preset::Full, o)
+                .build_into(&mut arena, Some(area), &mut bvh)
                 .unwrap();
             let pah = AreaPah::new(area, o.perspective);
             let estimate = bvh.estimated_cost_over(&pah, o.constants, pah.window_measure());
@@ -635,11 +504,11 @@ mod tests {
         let mut bvh = Bvh::default();
         let o = PresetOptions::default();
         assert_eq!(
-            Preset::Full.build_into(None, &o, &mut arena, &mut bvh),
+            BuildOptions::with_settings(Preset::Full, o).build_into(&mut arena, None, &mut bvh),
             Err(PresetError::NeedsArea(Preset::Full))
         );
-        assert!(Preset::Standard
-            .build_into(None, &o, &mut arena, &mut bvh)
+        assert!(BuildOptions::with_settings(Preset::Standard, o)
+            .build_into(&mut arena, None, &mut bvh)
             .is_ok());
         assert_eq!(Preset::from_name("FULL"), Some(Preset::Full));
         assert_eq!(Preset::from_name("nope"), None);

@@ -61,6 +61,7 @@
 //! # Ok::<(), Box<dyn core::error::Error>>(())
 //! ```
 
+mod area_pah;
 mod axis;
 mod cost;
 mod pah_ortho;
@@ -68,6 +69,7 @@ mod pah_perspective;
 mod spfh;
 mod termination;
 
+pub use area_pah::AreaPah;
 pub use axis::{AllAxes, AxisChooser, AxisOrder, LongestAxis};
 pub use cost::{CostConstants, CostModel, Sah};
 pub use pah_ortho::PahOrtho;

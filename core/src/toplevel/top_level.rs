@@ -4,7 +4,7 @@ use alloc::vec::Vec;
 use core::fmt;
 
 use super::{AreaList, AreaLookup, BreakEven, Octree};
-use crate::builder::{BuildArena, Preset, PresetError, PresetOptions, ReinsertConfig};
+use crate::builder::{BuildArena, BuildOptions, Preset, PresetError, ReinsertConfig};
 use crate::bvh::{Bvh, Hit, Traversable, TraversalStats, WideBvh};
 use crate::geometry::{Ray, Triangle};
 use crate::heuristics::CostConstants;
@@ -18,51 +18,59 @@ const EXIT_OVERLAP: f32 = 1e-5;
 /// How a [`TopLevel`] is built.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TopLevelOptions {
-    /// The preset of every local BVH: `pah` by default (binned SAH pricing its cuts with the
-    /// area's PAH), whose local trees cost less per ray on average than `sah`'s and the thesis's
-    /// `full` (PAH + SPFH) over the thesis's configurations; `full` is costlier on architectural
-    /// scenes.
-    pub preset: Preset,
-    /// Settings of the local builds.
-    pub local: PresetOptions,
-    /// The fallback BVH's preset: `sah` (the default) or `standard`, which needs no area (the
+    /// How every local BVH is built: the `pah` preset by default (binned SAH pricing its cuts
+    /// with the area's PAH), whose local trees cost less per ray on average than `sah`'s and the
+    /// thesis's `full` (PAH + SPFH) over the thesis's configurations; `full` is costlier on
+    /// architectural scenes. Its reinsertion runs under the preset's model (the area's PAH for
+    /// the PAH presets).
+    pub local: BuildOptions,
+    /// How the fallback BVH is built: `sah` (the default) or `standard`, which needs no area (the
     /// thesis's fallback was SAH + LSPH).
-    pub fallback_preset: Preset,
-    /// Settings of the fallback build.
-    pub fallback: PresetOptions,
+    pub fallback: BuildOptions,
     /// How many affine areas a query tries before falling back (the thesis used 1).
     pub max_tries: u32,
-    /// Reinsertion after each build, or none (the default): every local BVH under its preset's
-    /// model ([`Preset::reinsert`]: the area's PAH for the PAH presets), the fallback under SAH.
-    pub reinsert: Option<ReinsertConfig>,
 }
 
 impl Default for TopLevelOptions {
     fn default() -> Self {
         Self {
-            preset: Preset::Pah,
-            local: PresetOptions::default(),
-            fallback_preset: Preset::Sah,
-            fallback: PresetOptions::default(),
+            local: BuildOptions::new(Preset::Pah),
+            fallback: BuildOptions::new(Preset::Sah),
             max_tries: 1,
-            reinsert: None,
         }
     }
 }
 
 impl TopLevelOptions {
-    /// Applies [`TopLevelOptions::reinsert`] to the local BVH built for `area`.
-    pub fn reinsert_local(&self, area: &InfluenceArea, bvh: &mut Bvh) {
-        if let Some(config) = &self.reinsert {
-            self.preset.reinsert(Some(area), &self.local, bvh, config);
+    /// The same options with `parallel` set for the local and the fallback builds: with the
+    /// `rayon` feature, the local BVHs build side by side with the fallback BVH, which is itself
+    /// threaded. The scene is the same.
+    pub fn parallel(self, parallel: bool) -> Self {
+        Self {
+            local: BuildOptions {
+                parallel,
+                ..self.local
+            },
+            fallback: BuildOptions {
+                parallel,
+                ..self.fallback
+            },
+            ..self
         }
     }
 
-    /// Applies [`TopLevelOptions::reinsert`] to the fallback BVH.
-    pub fn reinsert_fallback(&self, bvh: &mut Bvh) {
-        if let Some(config) = &self.reinsert {
-            self.fallback_preset
-                .reinsert(None, &self.fallback, bvh, config);
+    /// The same options with `reinsert` for the local and the fallback builds.
+    pub fn reinsert(self, reinsert: Option<ReinsertConfig>) -> Self {
+        Self {
+            local: BuildOptions {
+                reinsert,
+                ..self.local
+            },
+            fallback: BuildOptions {
+                reinsert,
+                ..self.fallback
+            },
+            ..self
         }
     }
 }
@@ -125,6 +133,32 @@ impl TopLevelStats {
 ///
 /// The trees `T` are binary [`Bvh`]s as built; [`TopLevel::widen`] turns every one into a
 /// [`WideBvh`] (4-wide nodes, the faster traversal) with the same answers.
+///
+/// ```
+/// use rdbvh_core::toplevel::DEFAULT_OCTREE_LEVELS;
+/// use rdbvh_core::{brute_force, InfluenceArea, PlaneArea, Ray, TopLevel, TopLevelOptions, Triangle, Vec3};
+///
+/// // A floor of 200 triangles at y = 0.
+/// let tris: Vec<Triangle> = (0..100)
+///     .flat_map(|i| {
+///         let o = Vec3::new((i % 10) as f32, 0.0, (i / 10) as f32);
+///         [Triangle::new(o, o + Vec3::X, o + Vec3::Z), Triangle::new(o + Vec3::X, o + Vec3::X + Vec3::Z, o + Vec3::Z)]
+///     })
+///     .collect();
+/// // An area light's parallel rays: a 2 x 2 window at y = 5, shining down (-y) for 6 units.
+/// let area: InfluenceArea = PlaneArea::new(Vec3::new(5.0, 5.0, 5.0), -Vec3::Y, 1.0, 1.0, 6.0)?.into();
+/// let options = TopLevelOptions::default(); // local BVH: the area's PAH; fallback: SAH
+/// let scene = TopLevel::with_octree(&tris, vec![area], &options, DEFAULT_OCTREE_LEVELS)?;
+///
+/// // A ray of the light's: its area's local BVH answers it.
+/// let shadow = Ray::new(Vec3::new(5.2, 4.9, 5.3), -Vec3::Y)?;
+/// assert!((scene.closest_hit(&shadow, &tris).unwrap().t - 4.9).abs() < 1e-5);
+/// // Any other ray: the fallback BVH. Both answer as brute force does.
+/// let other = Ray::new(Vec3::new(-1.0, 1.0, 2.5), Vec3::new(1.0, -0.5, 0.0))?;
+/// assert_eq!(scene.closest_hit(&other, &tris), brute_force::closest_hit(&other, &tris));
+/// assert!(scene.any_hit(&shadow, &tris));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct TopLevel<L: AreaLookup = Octree, T: Traversable = Bvh> {
     areas: Vec<InfluenceArea>,
@@ -158,45 +192,47 @@ impl TopLevel<AreaList> {
 }
 
 impl<L: AreaLookup> TopLevel<L> {
-    /// Builds the local BVHs (one arena for all), the fallback BVH and the lookup.
+    /// Builds the local BVHs, the fallback BVH and the lookup. With
+    /// [`BuildOptions::parallel`] set (and the `rayon` feature), the local BVHs build on rayon's
+    /// threads beside the fallback BVH; the scene is the same.
     pub fn build(
         tris: &[Triangle],
         areas: Vec<InfluenceArea>,
         options: &TopLevelOptions,
         lookup: impl FnOnce(&[InfluenceArea]) -> L,
     ) -> Result<Self, TopLevelError> {
-        let mut arena = BuildArena::with_capacity(tris.len());
-        let mut local = Vec::with_capacity(areas.len());
-        for (i, area) in areas.iter().enumerate() {
-            let fail = |error| TopLevelError::Local {
+        let local_build = |i: usize, area: &InfluenceArea| {
+            let fail = |error: PresetError| TopLevelError::Local {
                 area: i as u32,
                 error,
             };
+            let ids: Vec<u32> = area.triangles_in(tris).collect();
+            let mut arena = BuildArena::with_capacity(ids.len());
             arena
-                .load_triangle_subset(tris, area.triangles_in(tris))
+                .load_triangle_subset(tris, ids)
                 .map_err(|e| fail(e.into()))?;
-            let mut bvh = Bvh::with_capacity(arena.len());
             options
-                .preset
-                .build_into(Some(area), &options.local, &mut arena, &mut bvh)
-                .map_err(fail)?;
-            options.reinsert_local(area, &mut bvh);
-            local.push(bvh);
-        }
-        arena
-            .load_triangles(tris)
-            .map_err(|e| TopLevelError::Fallback(e.into()))?;
-        let mut fallback = Bvh::with_capacity(tris.len());
-        options
-            .fallback_preset
-            .build_into(None, &options.fallback, &mut arena, &mut fallback)
-            .map_err(TopLevelError::Fallback)?;
-        options.reinsert_fallback(&mut fallback);
+                .local
+                .build_loaded(&mut arena, Some(area))
+                .map_err(fail)
+        };
+        let fallback_build = || {
+            options
+                .fallback
+                .build(tris, None)
+                .map_err(TopLevelError::Fallback)
+        };
+        let threaded = options.local.parallel || options.fallback.parallel;
+        let (local, fallback) = side_by_side(
+            threaded,
+            || map_areas(threaded, &areas, local_build),
+            fallback_build,
+        );
         let lookup = lookup(&areas);
         Ok(Self {
             areas,
-            local,
-            fallback,
+            local: local?,
+            fallback: fallback?,
             lookup,
             max_tries: options.max_tries,
         })
@@ -420,6 +456,37 @@ impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
 }
 
 /// Keeps the elements whose `mask` entry is true.
+/// Runs `a` and `b` on rayon's threads when `threaded` (and the `rayon` feature) say so, else
+/// one after the other.
+fn side_by_side<A: Send, B: Send>(
+    threaded: bool,
+    a: impl FnOnce() -> A + Send,
+    b: impl FnOnce() -> B + Send,
+) -> (A, B) {
+    #[cfg(feature = "rayon")]
+    if threaded {
+        return rayon::join(a, b);
+    }
+    let _ = threaded;
+    (a(), b())
+}
+
+/// `f` over every area in order, on rayon's threads when `threaded` (and the `rayon` feature) say
+/// so; the first error stops it.
+fn map_areas<R: Send, E: Send>(
+    threaded: bool,
+    areas: &[InfluenceArea],
+    f: impl Fn(usize, &InfluenceArea) -> Result<R, E> + Sync + Send,
+) -> Result<Vec<R>, E> {
+    #[cfg(feature = "rayon")]
+    if threaded {
+        use rayon::prelude::*;
+        return areas.par_iter().enumerate().map(|(i, a)| f(i, a)).collect();
+    }
+    let _ = threaded;
+    areas.iter().enumerate().map(|(i, a)| f(i, a)).collect()
+}
+
 fn retain_by_mask<T>(v: &mut Vec<T>, mask: &[bool]) {
     let mut keep = mask.iter();
     v.retain(|_| keep.next().copied().unwrap_or(false));
@@ -556,5 +623,32 @@ mod tests {
         scene.retain_areas(|i| i == 1);
         assert_eq!(scene.areas().len(), 1);
         assert_eq!(scene.local_bvhs().len(), 1);
+    }
+
+    #[cfg(feature = "rayon")]
+    #[test]
+    fn threaded_scene_equals_single_threaded() {
+        let mut tris = soup(5_000, 9);
+        // Long triangles across the soup, so that reinsertion moves something.
+        tris.extend((0..100).map(|i| {
+            let y = i as f32 * 0.1;
+            Triangle::new(
+                Vec3::new(0.0, y, 0.0),
+                Vec3::new(10.0, y, 10.0),
+                Vec3::new(0.0, y + 0.1, 10.0),
+            )
+        }));
+        let mut fallbacks = Vec::new();
+        for reinsert in [None, Some(ReinsertConfig::default())] {
+            let serial = TopLevelOptions::default().reinsert(reinsert);
+            let threaded = serial.parallel(true);
+            let a = TopLevel::with_octree(&tris, areas(), &threaded, 5).unwrap();
+            let b = TopLevel::with_octree(&tris, areas(), &serial, 5).unwrap();
+            assert_eq!(a.local_bvhs(), b.local_bvhs());
+            assert_eq!(a.fallback(), b.fallback());
+            fallbacks.push(a.fallback().clone());
+        }
+        // The option reaches the trees.
+        assert!(fallbacks[0] != fallbacks[1], "reinsertion changed nothing");
     }
 }

@@ -5,14 +5,16 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use rdbvh_core::analyze::{analyze, containment, NodeRecord, NodeRecords, THESIS_LEVELS};
-use rdbvh_core::builder::{AreaPah, Preset};
+use rdbvh_core::builder::{BuildOptions, Preset};
+use rdbvh_core::heuristics::AreaPah;
 use rdbvh_core::heuristics::Sah;
 use rdbvh_core::influence::InfluenceArea;
 use rdbvh_core::toplevel::Octree;
 use serde_json::{json, Value};
 
 use super::areas::load_areas;
-use super::{load_scene, CliError};
+use super::error::CliError;
+use super::inputs::load_scene;
 use crate::experiment::{
     build_fallback, run_one, settings_of, ExperimentError, RaySource, RunMetrics, RunSetup,
     Settings,
@@ -356,7 +358,7 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
     if let Some(nodes) = &args.nodes {
         let mut inputs = vec![Path::new(&args.scene), args.areas.as_path()];
         inputs.extend(args.recorded_rays.as_deref());
-        super::check_output(nodes, &inputs)?;
+        super::inputs::check_output(nodes, &inputs)?;
         if args.columns.is_some() && is_json(nodes) {
             return Err(CliError::Usage(
                 "--columns chooses the CSV export's columns; a .json export writes every field"
@@ -396,8 +398,8 @@ pub fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), CliError> {
                 let mut arena = rdbvh_core::builder::BuildArena::with_capacity(ids.len());
                 arena.load_triangle_subset(&scene.triangles, ids)?;
                 let mut bvh = rdbvh_core::bvh::Bvh::with_capacity(arena.len());
-                preset
-                    .build_into(Some(&entry.area), &setup.local, &mut arena, &mut bvh)
+                BuildOptions::with_settings(preset, setup.local)
+                    .build_into(&mut arena, Some(&entry.area), &mut bvh)
                     .map_err(|e| CliError::Usage(e.to_string()))?;
                 let pah = AreaPah::new(&entry.area, setup.local.perspective);
                 let (sah, pah) = analyze(&bvh, (NodeRecords::new(Sah), NodeRecords::new(pah)));

@@ -8,7 +8,7 @@ use std::path::Path;
 use rayon::prelude::*;
 use rdbvh_core::bvh::Hit;
 
-use super::CliError;
+use super::error::CliError;
 
 /// The answers of one batch, in ray order.
 #[derive(Clone, Debug, PartialEq)]

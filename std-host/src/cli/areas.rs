@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::influence::InfluenceArea;
 
-use super::CliError;
+use super::error::CliError;
 use crate::areas::{read_areas, AreaEntry};
 use crate::scene::Scene;
 

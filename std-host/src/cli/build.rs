@@ -6,14 +6,15 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use rdbvh_core::builder::AreaPah;
+use rdbvh_core::heuristics::AreaPah;
 use rdbvh_core::heuristics::{CostConstants, Sah};
 
 use serde::Serialize;
 
 use super::areas::{kind_name, load_areas, overlapping};
 use super::builder::BuilderArgs;
-use super::{load_scene, CliError};
+use super::error::CliError;
+use super::inputs::load_scene;
 
 /// Arguments of `rdbvh build`.
 #[derive(Args, Clone, Debug)]

@@ -5,17 +5,17 @@ use std::time::Instant;
 use clap::builder::PossibleValue;
 use clap::{value_parser, Args, ValueEnum};
 use rdbvh_core::builder::{
-    reinsert, BuildArena, BuildConfig, Builder, Preset, PresetOptions, ReinsertConfig,
-    ReinsertStats, MAX_BINS,
+    parallel, reinsert, BuildArena, BuildConfig, BuildOptions, Builder, Preset, PresetOptions,
+    ReinsertConfig, ReinsertStats, MAX_BINS,
 };
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::heuristics::{AxisChooser, Sah, SahTermination};
 use rdbvh_core::influence::InfluenceArea;
+use rdbvh_core::BuildError;
 use serde::Serialize;
 
-use super::CliError;
-use crate::parallel;
+use super::error::CliError;
 
 /// Which split axes the binned SAH builder tries.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Serialize)]
@@ -229,7 +229,8 @@ impl BuilderArgs {
 
     /// Builds a BVH over the triangles of `triangles` whose ids `subset` lists (all when
     /// `None`), for the influence area `area` when the preset needs one, on every thread of the
-    /// current rayon pool ([`crate::parallel`]: the single-threaded build's tree, node for node).
+    /// current rayon pool ([`rdbvh_core::builder::parallel`]: the single-threaded build's tree, node
+    /// for node).
     pub fn build_over(
         &self,
         triangles: &[Triangle],
@@ -256,19 +257,20 @@ impl BuilderArgs {
             Some(ids) => arena.load_triangle_subset(triangles, ids.iter().copied())?,
             None => parallel::load_triangles(&mut arena, triangles)?,
         }
-        let options = self.preset_options();
-        let mut bvh = match (self.preset(), for_wide) {
-            (Some(p), false) => parallel::build_preset(p, area, &options, &mut arena)?,
-            (Some(p), true) => parallel::build_preset_for_wide(p, area, &options, &mut arena)?,
+        let mut bvh = match self.preset() {
+            Some(p) => BuildOptions {
+                for_wide,
+                parallel: true,
+                ..BuildOptions::with_settings(p, self.preset_options())
+            }
+            .build_loaded(&mut arena, area)?,
             // Only the bins and the leaf size change: each builder keeps the rest of its own
             // configuration (LSPH evaluates its first axis only, which a default config would
             // undo).
-            (None, _) => match self.kind() {
-                BuilderKind::Sah => {
-                    parallel::build_arena_as(self.apply(Builder::sah()), &mut arena, for_wide)?
-                }
+            None => match self.kind() {
+                BuilderKind::Sah => build_plain(self.apply(Builder::sah()), &mut arena, for_wide)?,
                 BuilderKind::Lsph => {
-                    parallel::build_arena_as(self.apply(Builder::lsph()), &mut arena, for_wide)?
+                    build_plain(self.apply(Builder::lsph()), &mut arena, for_wide)?
                 }
             },
         };
@@ -277,7 +279,8 @@ impl BuilderArgs {
             let start = Instant::now();
             let config = ReinsertConfig::default();
             let stats = match self.preset() {
-                Some(p) => p.reinsert(area, &self.preset_options(), &mut bvh, &config),
+                Some(p) => BuildOptions::with_settings(p, self.preset_options())
+                    .reinsert_with(area, &mut bvh, &config),
                 None => reinsert(&mut bvh, &Sah, &config),
             };
             (stats, start.elapsed().as_secs_f64())
@@ -296,6 +299,19 @@ impl BuilderArgs {
         b.config.bins = self.bins();
         b.termination.max_leaf = self.max_leaf();
         b
+    }
+}
+
+/// Builds with a plain SAH builder on every thread, made [`Builder::for_wide`] when `for_wide`.
+fn build_plain<A: AxisChooser + Sync>(
+    builder: Builder<A, Sah, SahTermination>,
+    arena: &mut BuildArena,
+    for_wide: bool,
+) -> Result<Bvh, BuildError> {
+    if for_wide {
+        parallel::build_loaded(&builder.for_wide(), arena)
+    } else {
+        parallel::build_loaded(&builder, arena)
     }
 }
 

@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use rdbvh_core::brute_force;
-use rdbvh_core::builder::Preset;
+use rdbvh_core::builder::{BuildOptions, Preset};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::{CostConstants, Sah};
 use rdbvh_core::influence::{InfluenceArea, PlaneArea, RaySampler};
@@ -23,10 +23,11 @@ use super::builder::{BuilderArgs, BuilderKind, BuiltBvh};
 use clap::Parser;
 
 use super::answers::Answers;
+use super::error::CliError;
+use super::inputs::load_scene;
 use super::render::{render, RenderReport};
 use super::structure::trace_structure;
 use super::trace::trace;
-use super::{load_scene, CliError};
 use crate::scene::{Mt19937, Scene};
 
 /// Rays per query kind and scene: enough to exercise the trees, few enough to finish at once.
@@ -123,7 +124,7 @@ pub fn run_with(out: &mut impl Write, image: &Path) -> Result<(), CliError> {
         format!(
             "\nall {checked} queries agree with brute force on both builders and through the \
              scene structure, on {}",
-            super::count(rayon::current_num_threads(), "thread")
+            super::words::count(rayon::current_num_threads(), "thread")
         ),
     )
 }
@@ -147,7 +148,7 @@ fn render_room(out: &mut impl Write, image: &Path) -> Result<(), CliError> {
             command.join(" ")
         ),
     )?;
-    super::check_output(image, &[])?;
+    super::inputs::check_output(image, &[])?;
     let mut reports: Vec<(RenderReport, Vec<u8>)> = Vec::new();
     for structure in ["global", "lights"] {
         let mut line = vec!["rdbvh"];
@@ -222,7 +223,7 @@ fn structure(out: &mut impl Write) -> Result<usize, CliError> {
     let (scene, _) = load_scene("builtin:room", None)?;
     let area = room_light_area()?;
     let options = TopLevelOptions {
-        preset: Preset::Full,
+        local: BuildOptions::new(Preset::Full),
         ..TopLevelOptions::default()
     };
     let start = Instant::now();

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::CliError;
+use super::error::CliError;
 use crate::experiment::{
     cheaper_groups, parse_presets, run_experiment, ExperimentOptions, Overrides,
 };
@@ -97,7 +97,7 @@ pub fn run(args: &ExperimentArgs, out: &mut dyn Write) -> Result<(), CliError> {
     writeln!(
         out,
         "{} in {:.1} s -> {}",
-        super::count(s.rows.len(), "run"),
+        super::words::count(s.rows.len(), "run"),
         s.seconds,
         args.out.join("results.csv").display()
     )

@@ -15,10 +15,12 @@ mod demo;
 mod error;
 mod experiment;
 mod help;
+mod inputs;
 mod rays;
 mod render;
 mod structure;
 mod trace;
+mod words;
 
 pub use analyze::{AnalyzeArgs, NODE_COLUMNS};
 pub use answers::Answers;
@@ -34,11 +36,8 @@ pub use trace::{trace, LookupKind, TraceArgs};
 use std::ffi::OsString;
 use std::io::{self, Write};
 use std::process::ExitCode;
-use std::time::Instant;
 
 use clap::{Parser, Subcommand};
-
-use crate::scene::Scene;
 
 /// Ray-distribution-aware BVHs: build and trace over OBJ scenes.
 #[derive(Parser, Debug)]
@@ -129,53 +128,6 @@ fn usage_error(e: &clap::Error) -> ExitCode {
     }
 }
 
-/// Fails early, before any work, when `path` cannot be an output file: it names a folder, its
-/// folder does not exist, or it is one of the command's `inputs` (writing it would destroy the
-/// input). Other failures, such as permissions, still show when it is written.
-fn check_output(path: &std::path::Path, inputs: &[&std::path::Path]) -> Result<(), CliError> {
-    let fail = |why: &str| CliError::Write {
-        path: path.to_path_buf(),
-        source: io::Error::new(io::ErrorKind::NotFound, why.to_string()),
-    };
-    if path.is_dir() {
-        return Err(fail("it is a folder"));
-    }
-    let folder = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => std::path::Path::new("."),
-    };
-    if !folder.is_dir() {
-        return Err(fail("its folder does not exist"));
-    }
-    check_not_input(path, inputs.iter().copied())
-}
-
-/// Fails when the output `path` is the same file as one of `inputs`: the same path, a symbolic
-/// link to it, or a hard link to it.
-fn check_not_input<'a>(
-    path: &std::path::Path,
-    inputs: impl IntoIterator<Item = &'a std::path::Path>,
-) -> Result<(), CliError> {
-    match crate::same_file::input_named_by(path, inputs) {
-        Some(input) => Err(CliError::Write {
-            path: path.to_path_buf(),
-            source: io::Error::new(
-                io::ErrorKind::AlreadyExists,
-                format!(
-                    "it is one of the command's input files ({})",
-                    input.display()
-                ),
-            ),
-        }),
-        None => Ok(()),
-    }
-}
-
-/// `n` things in words: "1 thread", "2 threads".
-fn count(n: usize, thing: &str) -> String {
-    format!("{n} {thing}{}", if n == 1 { "" } else { "s" })
-}
-
 /// clap's message without its usage block, on one line.
 fn one_line(message: &str) -> String {
     let body = message.split("\nUsage:").next().unwrap_or(message);
@@ -189,22 +141,6 @@ fn one_line(message: &str) -> String {
         line = format!("error: {line}");
     }
     format!("{line} (see rdbvh --help)")
-}
-
-/// Opens a scene (a path or `builtin:NAME`), prints its warnings to standard error, and returns
-/// it with the seconds it took. Fails when `output` (checked by [`check_output`] already) is one
-/// of the material libraries the scene read: those are inputs too, known only once read.
-fn load_scene(spec: &str, output: Option<&std::path::Path>) -> Result<(Scene, f64), CliError> {
-    let start = Instant::now();
-    let scene = Scene::open(spec)?;
-    let seconds = start.elapsed().as_secs_f64();
-    if let Some(output) = output {
-        check_not_input(output, scene.material_files.iter().map(|p| p.as_path()))?;
-    }
-    for w in &scene.warnings {
-        eprintln!("warning: {}: {w}", scene.name);
-    }
-    Ok((scene, seconds))
 }
 
 #[cfg(test)]

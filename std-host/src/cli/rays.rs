@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use super::CliError;
+use super::error::CliError;
 use crate::experiment::RaySource;
 use crate::text_lines::line_at;
 
@@ -307,7 +307,7 @@ fn read_rows<R: Read>(
         if bytes.len() != columns.fields {
             let reason = format!(
                 "has {}, but the header has {}",
-                super::count(bytes.len(), "field"),
+                super::words::count(bytes.len(), "field"),
                 columns.fields
             );
             return Err(fail(at, rays.len(), false, reason));
@@ -372,7 +372,7 @@ fn csv_reason(e: &csv::Error) -> String {
             expected_len, len, ..
         } => format!(
             "has {}, but the header has {expected_len}",
-            super::count(usize::try_from(*len).unwrap_or(usize::MAX), "field")
+            super::words::count(usize::try_from(*len).unwrap_or(usize::MAX), "field")
         ),
         csv::ErrorKind::Utf8 { .. } => "not valid UTF-8".to_string(),
         csv::ErrorKind::Io(io) => format!("cannot read: {io}"),

@@ -11,8 +11,9 @@ use rdbvh_core::Vec3;
 use serde::Serialize;
 
 use super::answers::{write_answers, Answers};
+use super::error::CliError;
+use super::inputs::load_scene;
 use super::rays::write_rays;
-use super::{load_scene, CliError};
 use crate::render::{
     emissive_lights, encode_png, mean_luminance, pilot_size, prune_by_pilot, read_lights,
     render_frame, replay_shadow_rays, to_srgb8, Camera, FrameSettings, Integrator, LightSet,
@@ -158,7 +159,7 @@ pub struct RenderReport {
 pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
     let mut inputs = vec![Path::new(&args.scene)];
     inputs.extend(args.lights.as_deref());
-    super::check_output(&args.out, &inputs)?;
+    super::inputs::check_output(&args.out, &inputs)?;
     if let Some(dir) = &args.record_rays {
         fs::create_dir_all(dir).map_err(|source| CliError::Write {
             path: dir.clone(),

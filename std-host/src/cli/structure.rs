@@ -7,7 +7,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use rdbvh_core::builder::{Preset, PresetOptions, ReinsertConfig};
+use rdbvh_core::builder::{BuildOptions, Preset, ReinsertConfig};
 use rdbvh_core::bvh::{Bvh, TraversalStats};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::CostConstants;
@@ -17,10 +17,10 @@ use rdbvh_core::toplevel::{
 
 use super::answers::{write_answers, Answers};
 use super::areas::load_areas;
+use super::error::CliError;
+use super::inputs::load_scene;
 use super::rays::read_rays;
 use super::trace::{check_outputs, LookupKind, TraceArgs};
-use super::{load_scene, CliError};
-use crate::parallel::build_scene;
 
 /// The preset of the local BVHs when `--preset` is not given: `pah`, the binned SAH builder
 /// pricing its cuts with the area's PAH ([`TopLevelOptions`]'s default too). Over the thesis's 48
@@ -163,14 +163,14 @@ fn fallback_alone(
 /// otherwise) with --thesis-mode/--bins/--max-leaf, the fallback with the defaults, and with
 /// --reinsert every tree reinserted with the default settings.
 pub fn structure_options(args: &TraceArgs) -> TopLevelOptions {
+    let local = args.builder.preset().unwrap_or(DEFAULT_LOCAL_PRESET);
     TopLevelOptions {
-        preset: args.builder.preset().unwrap_or(DEFAULT_LOCAL_PRESET),
-        local: args.builder.preset_options(),
-        fallback_preset: Preset::Sah,
-        fallback: PresetOptions::default(),
+        local: BuildOptions::with_settings(local, args.builder.preset_options()),
+        fallback: BuildOptions::new(Preset::Sah),
         max_tries: args.max_tries,
-        reinsert: args.builder.reinsert.then(ReinsertConfig::default),
     }
+    .reinsert(args.builder.reinsert.then(ReinsertConfig::default))
+    .parallel(true)
 }
 
 /// Runs `rdbvh trace --areas ...`; the summary goes to `log`.
@@ -194,19 +194,19 @@ pub fn run(args: &TraceArgs, areas_path: &Path, log: &mut impl Write) -> Result<
     let areas: Vec<_> = entries.iter().map(|e| e.area).collect();
     let options = structure_options(args);
 
-    crate::parallel::start_pool();
+    rdbvh_core::builder::parallel::start_pool();
     let start = Instant::now();
     match args.lookup {
         LookupKind::Octree => {
             let levels = args.octree_levels.unwrap_or(DEFAULT_OCTREE_LEVELS);
-            let s = build_scene(&scene.triangles, areas, &options, |a| {
+            let s = TopLevel::build(&scene.triangles, areas, &options, |a| {
                 Octree::build(a, levels)
             })?;
             let build_seconds = start.elapsed().as_secs_f64();
             let o = s.lookup().stats();
             let lookup = format!(
                 "octree of {} ({} used, {} nodes, {} leaves)",
-                super::count(levels as usize, "level"),
+                super::words::count(levels as usize, "level"),
                 o.levels,
                 o.nodes,
                 o.leaves
@@ -214,7 +214,7 @@ pub fn run(args: &TraceArgs, areas_path: &Path, log: &mut impl Write) -> Result<
             finish(args, &scene, &rays, &s, &lookup, build_seconds, log)
         }
         LookupKind::List => {
-            let s = build_scene(&scene.triangles, areas, &options, |a| {
+            let s = TopLevel::build(&scene.triangles, areas, &options, |a| {
                 AreaList::new(a.len())
             })?;
             let build_seconds = start.elapsed().as_secs_f64();
@@ -259,11 +259,11 @@ fn finish<L: AreaLookup + Sync>(
     let lines = [
         format!(
             "traced {} ({kind}) against {} through {} with {}: {}, {:.3} ms, {:.0} rays/s",
-            super::count(n, "ray"),
-            super::count(scene.len(), "triangle"),
-            super::count(areas, "influence area"),
-            super::count(rayon::current_num_threads(), "thread"),
-            super::count(t.answers.hits(), "hit"),
+            super::words::count(n, "ray"),
+            super::words::count(scene.len(), "triangle"),
+            super::words::count(areas, "influence area"),
+            super::words::count(rayon::current_num_threads(), "thread"),
+            super::words::count(t.answers.hits(), "hit"),
             t.seconds * 1e3,
             per_second(t.seconds)
         ),
@@ -272,7 +272,7 @@ fn finish<L: AreaLookup + Sync>(
              used the fallback BVH)",
             100.0 * t.local_hit_rate(n),
             t.local,
-            super::count(n, "ray"),
+            super::words::count(n, "ray"),
             t.affine,
             n - t.local
         ),
@@ -287,14 +287,14 @@ fn finish<L: AreaLookup + Sync>(
         format!(
             "structure: `{}` {}{} holding {} (a triangle once per area it overlaps), {lookup}, \
              up to {} tr{} per ray, {} bytes, built in {:.3} ms",
-            options.preset,
-            super::count(areas, "local BVH"),
-            if options.local.thesis_mode {
+            options.local.preset,
+            super::words::count(areas, "local BVH"),
+            if options.local.settings.thesis_mode {
                 " (thesis mode)"
             } else {
                 ""
             },
-            super::count(local_triangles as usize, "triangle"),
+            super::words::count(local_triangles as usize, "triangle"),
             options.max_tries,
             if options.max_tries == 1 { "y" } else { "ies" },
             structure.memory_bytes(),

@@ -14,8 +14,9 @@ use rdbvh_core::toplevel::MAX_OCTREE_LEVELS;
 
 use super::answers::{write_answers, Answers};
 use super::builder::BuilderArgs;
+use super::error::CliError;
+use super::inputs::load_scene;
 use super::rays::read_rays;
-use super::{load_scene, CliError};
 
 /// How the scene structure finds the areas that may contain a ray's origin.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -90,7 +91,7 @@ pub fn trace<T: Traversable + Sync>(
 pub(super) fn check_outputs(args: &TraceArgs) -> Result<(), CliError> {
     let inputs = [Path::new(&args.scene), args.rays.as_path()];
     let areas = args.areas.as_deref().into_iter();
-    super::check_output(
+    super::inputs::check_output(
         &args.out,
         &inputs.into_iter().chain(areas).collect::<Vec<_>>(),
     )
@@ -126,10 +127,10 @@ pub fn run(args: &TraceArgs, log: &mut impl Write) -> Result<(), CliError> {
     writeln!(
         log,
         "traced {} ({kind}) against {} with {}: {}, {:.3} ms, {:.0} rays/s",
-        super::count(rays.len(), "ray"),
-        super::count(scene.len(), "triangle"),
-        super::count(rayon::current_num_threads(), "thread"),
-        super::count(answers.hits(), "hit"),
+        super::words::count(rays.len(), "ray"),
+        super::words::count(scene.len(), "triangle"),
+        super::words::count(rayon::current_num_threads(), "thread"),
+        super::words::count(answers.hits(), "hit"),
         seconds * 1e3,
         per_second
     )

@@ -5,9 +5,10 @@ use std::time::Instant;
 use rdbvh_core::analyze::{
     analyze, Epo, EstimatedCost, OverlapSpace, RayCostSums, RayCosts, SiblingOverlap, TreeShape,
 };
-use rdbvh_core::builder::{AreaPah, BuildArena, Preset, PresetOptions};
+use rdbvh_core::builder::{BuildArena, BuildOptions, Preset, PresetOptions};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::{Ray, Triangle};
+use rdbvh_core::heuristics::AreaPah;
 use rdbvh_core::heuristics::CostConstants;
 use rdbvh_core::influence::{InfluenceArea, PointDistribution, RaySampler};
 use rdbvh_core::toplevel::{Octree, TopLevel};
@@ -91,9 +92,8 @@ pub fn build_fallback(tris: &[Triangle], setup: &RunSetup) -> Result<Bvh, Experi
         .load_triangles(tris)
         .map_err(|e| ExperimentError::Build(format!("fallback BVH: {e}")))?;
     let mut out = Bvh::with_capacity(tris.len());
-    setup
-        .fallback_preset
-        .build_into(None, &setup.fallback, &mut arena, &mut out)
+    BuildOptions::with_settings(setup.fallback_preset, setup.fallback)
+        .build_into(&mut arena, None, &mut out)
         .map_err(|e| ExperimentError::Build(format!("fallback BVH: {e}")))?;
     Ok(out)
 }
@@ -116,8 +116,8 @@ pub fn run_one(
     arena
         .load_triangle_subset(tris, ids.iter().copied())
         .map_err(|e| ExperimentError::Build(format!("local BVH: {e}")))?;
-    preset
-        .build_into(Some(area), &setup.local, &mut arena, &mut local)
+    BuildOptions::with_settings(preset, setup.local)
+        .build_into(&mut arena, Some(area), &mut local)
         .map_err(|e| ExperimentError::Build(format!("local BVH ({preset}): {e}")))?;
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
     let profile = {
@@ -125,14 +125,8 @@ pub fn run_one(
             .load_triangle_subset(tris, ids.iter().copied())
             .map_err(|e| ExperimentError::Build(format!("local BVH: {e}")))?;
         let mut scratch = Bvh::with_capacity(ids.len());
-        preset
-            .build_into_profiled(
-                Some(area),
-                &setup.local,
-                &mut arena,
-                &mut scratch,
-                &StdClock::new(),
-            )
+        BuildOptions::with_settings(preset, setup.local)
+            .build_into_profiled(&mut arena, Some(area), &mut scratch, &StdClock::new())
             .map_err(|e| ExperimentError::Build(format!("local BVH ({preset}): {e}")))?
             .profile
     };

@@ -4,6 +4,7 @@
 use std::fmt;
 use std::path::PathBuf;
 
+use rdbvh_core::builder::PresetError;
 use rdbvh_core::light_buffer::LightSourceError;
 use rdbvh_core::BuildError;
 
@@ -105,6 +106,18 @@ impl std::error::Error for RenderError {
 impl From<BuildError> for RenderError {
     fn from(e: BuildError) -> Self {
         RenderError::Build(e)
+    }
+}
+
+/// The global BVH's preset needs no area, so a preset's error is its build's.
+impl From<PresetError> for RenderError {
+    fn from(e: PresetError) -> Self {
+        match e {
+            PresetError::Build(e) => RenderError::Build(e),
+            PresetError::NeedsArea(_) => RenderError::Build(BuildError::InvalidConfig(
+                "the global BVH's preset needs an influence area",
+            )),
+        }
     }
 }
 

@@ -7,15 +7,13 @@
 
 use std::time::Instant;
 
-use rdbvh_core::builder::{reinsert, Builder, ReinsertConfig};
+use rdbvh_core::builder::{parallel, BuildOptions, Preset};
 use rdbvh_core::bvh::{Hit, TraversalStats, WideBvh};
 use rdbvh_core::geometry::{Ray, Triangle};
-use rdbvh_core::heuristics::Sah;
 use rdbvh_core::light_buffer::LightBuffer;
 
 use super::light_structure::light_buffers;
 use super::{Light, RenderError};
-use crate::parallel;
 
 /// Which structure answers the shadow rays (`--structure`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -62,8 +60,12 @@ impl Structure {
     ) -> Result<Self, RenderError> {
         parallel::start_pool();
         let start = Instant::now();
-        let mut bvh = parallel::build(&Builder::sah(), triangles)?;
-        reinsert(&mut bvh, &Sah, &ReinsertConfig::default());
+        let options = BuildOptions {
+            reinsert: Some(Default::default()),
+            parallel: true,
+            ..BuildOptions::new(Preset::Sah)
+        };
+        let bvh = options.build(triangles, None)?;
         let global = WideBvh::from_binary(&bvh, triangles);
         let (buffers, buffer_of) = match kind {
             StructureKind::Global => (Vec::new(), vec![NO_BUFFER; lights.len()]),

@@ -1,4 +1,6 @@
-//! Threaded builds with rayon: the same trees as the single-threaded core builder, sooner.
+//! Threaded builds on rayon's pool (the `rayon` feature): the same trees as the one-thread
+//! build, sooner. [`super::BuildOptions::parallel`] runs a preset here; these functions run any
+//! [`Builder`].
 //!
 //! A binary build is split where subtrees get small: the core builds the top of the tree on one
 //! thread and hands over each node of at most `cutoff` primitives as a job the moment it reaches
@@ -14,22 +16,21 @@
 //! are binned in parallel parts ([`Builder::build_top_with`]); bins merge exactly, so neither
 //! changes the tree.
 
-use rayon::prelude::*;
+use alloc::collections::BinaryHeap;
+use alloc::vec::Vec;
+use core::cmp::{Ordering, Reverse};
 
-use std::cmp::{Ordering, Reverse};
-use std::collections::BinaryHeap;
+use rayon::prelude::*;
 use std::sync::Mutex;
 
-use rdbvh_core::builder::{
-    BinJob, BuildArena, Builder, GraftBlock, LoadedBounds, NodeBinner, NodeBins, Preset,
-    PresetError, PresetOptions, PresetVisitor, Subtree, SubtreeSink, TriangleLoad,
+use super::{
+    BinJob, BuildArena, Builder, GraftBlock, LoadedBounds, NodeBinner, NodeBins, Subtree,
+    SubtreeSink, TriangleLoad,
 };
-use rdbvh_core::bvh::Bvh;
-use rdbvh_core::geometry::Triangle;
-use rdbvh_core::heuristics::{AxisChooser, CostModel, Termination};
-use rdbvh_core::influence::InfluenceArea;
-use rdbvh_core::toplevel::{AreaLookup, TopLevel, TopLevelError, TopLevelOptions};
-use rdbvh_core::BuildError;
+use crate::bvh::Bvh;
+use crate::geometry::Triangle;
+use crate::heuristics::{AxisChooser, CostModel, Termination};
+use crate::BuildError;
 
 /// Jobs per thread: enough that uneven subtrees still balance across threads, few enough that
 /// the top (whose partitions run on one thread) stays shallow. On 2 threads, 4 beat 16 and 2
@@ -95,7 +96,7 @@ where
 {
     let mut arena = BuildArena::with_capacity(tris.len());
     arena.load_triangles_with(tris, load_parallel)?;
-    build_arena(builder, &mut arena)
+    build_loaded(builder, &mut arena)
 }
 
 /// Starts the global pool's threads, which rayon does on first use: a command calls it before
@@ -110,81 +111,9 @@ pub fn load_triangles(arena: &mut BuildArena, tris: &[Triangle]) -> Result<(), B
     arena.load_triangles_with(tris, load_parallel)
 }
 
-/// Builds `preset` (for `area`, when it needs one) over the primitives loaded in `arena` with
-/// every rayon thread. Equal to the tree of `preset.build_into(area, options, arena, ..)`.
-pub fn build_preset(
-    preset: Preset,
-    area: Option<&InfluenceArea>,
-    options: &PresetOptions,
-    arena: &mut BuildArena,
-) -> Result<Bvh, PresetError> {
-    build_preset_as(preset, area, options, arena, false)
-}
-
-/// [`build_preset`] for a tree that is only to be collapsed to 4-wide nodes: the preset's builder
-/// made [`Builder::for_wide`], so nodes of at most four triangles are not split (the collapse
-/// would make each one leaf block anyway). `WideBvh::from_binary` of the result has the nodes of
-/// the full tree's collapse; the build skips about a fifth of its work.
-pub fn build_preset_for_wide(
-    preset: Preset,
-    area: Option<&InfluenceArea>,
-    options: &PresetOptions,
-    arena: &mut BuildArena,
-) -> Result<Bvh, PresetError> {
-    build_preset_as(preset, area, options, arena, true)
-}
-
-/// [`build_preset`], its builder made [`Builder::for_wide`] when `for_wide` is true.
-fn build_preset_as(
-    preset: Preset,
-    area: Option<&InfluenceArea>,
-    options: &PresetOptions,
-    arena: &mut BuildArena,
-    for_wide: bool,
-) -> Result<Bvh, PresetError> {
-    Ok(preset.with_builder(area, options, Threaded { arena, for_wide })??)
-}
-
-/// Runs a preset's builder (made [`Builder::for_wide`] when asked) on every thread.
-struct Threaded<'a> {
-    arena: &'a mut BuildArena,
-    for_wide: bool,
-}
-
-impl PresetVisitor for Threaded<'_> {
-    type Output = Result<Bvh, BuildError>;
-    fn visit<A, C, T>(self, builder: Builder<A, C, T>) -> Self::Output
-    where
-        A: AxisChooser + Send + Sync,
-        C: CostModel + Send + Sync,
-        T: Termination + Send + Sync,
-    {
-        build_arena_as(builder, self.arena, self.for_wide)
-    }
-}
-
-/// [`build_arena`] with `builder`, made [`Builder::for_wide`] when `for_wide` is true (a tree only
-/// to be collapsed to 4-wide nodes).
-pub(crate) fn build_arena_as<A, C, T>(
-    builder: Builder<A, C, T>,
-    arena: &mut BuildArena,
-    for_wide: bool,
-) -> Result<Bvh, BuildError>
-where
-    A: AxisChooser + Sync,
-    C: CostModel + Sync,
-    T: Termination + Sync,
-{
-    if for_wide {
-        build_arena(&builder.for_wide(), arena)
-    } else {
-        build_arena(&builder, arena)
-    }
-}
-
 /// Builds over the primitives loaded in `arena` with every rayon thread. Equal to
 /// `builder.build_into(arena, ..)`.
-pub fn build_arena<A, C, T>(
+pub fn build_loaded<A, C, T>(
     builder: &Builder<A, C, T>,
     arena: &mut BuildArena,
 ) -> Result<Bvh, BuildError>
@@ -326,68 +255,14 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Builds a [`TopLevel`] with its local BVHs (one per thread at a time) and its fallback BVH (itself
-/// threaded) on all threads; equal to [`TopLevel::build`]'s scene.
-pub fn build_scene<L: AreaLookup>(
-    tris: &[Triangle],
-    areas: Vec<InfluenceArea>,
-    options: &TopLevelOptions,
-    lookup: impl FnOnce(&[InfluenceArea]) -> L,
-) -> Result<TopLevel<L>, TopLevelError> {
-    let local_build = |(i, area): (usize, &InfluenceArea)| {
-        let fail = |error: PresetError| TopLevelError::Local {
-            area: i as u32,
-            error,
-        };
-        let ids: Vec<u32> = area.triangles_in(tris).collect();
-        let mut arena = BuildArena::with_capacity(ids.len());
-        arena
-            .load_triangle_subset(tris, ids)
-            .map_err(|e| fail(e.into()))?;
-        let mut bvh = Bvh::with_capacity(arena.len());
-        options
-            .preset
-            .build_into(Some(area), &options.local, &mut arena, &mut bvh)
-            .map_err(fail)?;
-        options.reinsert_local(area, &mut bvh);
-        Ok(bvh)
-    };
-    // The fallback, over every triangle, is itself built on every thread.
-    let fallback_build = || {
-        let mut arena = BuildArena::with_capacity(tris.len());
-        load_triangles(&mut arena, tris).map_err(|e| TopLevelError::Fallback(e.into()))?;
-        let mut bvh = build_preset(options.fallback_preset, None, &options.fallback, &mut arena)
-            .map_err(TopLevelError::Fallback)?;
-        options.reinsert_fallback(&mut bvh);
-        Ok::<_, TopLevelError>(bvh)
-    };
-    let (local, fallback) = rayon::join(
-        || {
-            areas
-                .par_iter()
-                .enumerate()
-                .map(local_build)
-                .collect::<Result<Vec<Bvh>, TopLevelError>>()
-        },
-        fallback_build,
-    );
-    let lookup = lookup(&areas);
-    Ok(
-        TopLevel::from_parts(areas, local?, fallback?, lookup, options.max_tries)
-            .expect("one local BVH per area by construction"),
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rdbvh_core::builder::{BuildConfig, ReinsertConfig};
-    use rdbvh_core::heuristics::{AllAxes, PahPerspective, PerspectiveMeasure, SahTermination};
-    use rdbvh_core::influence::InfluenceArea;
-    use rdbvh_core::influence::{PlaneArea, PointArea};
-    use rdbvh_core::random::Pcg32;
-    use rdbvh_core::toplevel::Octree;
-    use rdbvh_core::Vec3;
+    use crate::builder::{BuildConfig, BuildOptions, Preset, PresetError, PresetOptions};
+    use crate::heuristics::{AllAxes, PahPerspective, PerspectiveMeasure, SahTermination};
+    use crate::influence::{InfluenceArea, PlaneArea, PointArea};
+    use crate::random::Pcg32;
+    use crate::Vec3;
 
     fn soup(n: usize) -> Vec<Triangle> {
         let mut rng = Pcg32::new(3);
@@ -451,28 +326,34 @@ mod tests {
                 .unwrap()
                 .into(),
         ];
-        for options in [PresetOptions::default(), PresetOptions::thesis()] {
+        for settings in [PresetOptions::default(), PresetOptions::thesis()] {
             for area in &areas {
                 for preset in Preset::ALL {
-                    let mut arena = BuildArena::with_capacity(tris.len());
-                    arena.load_triangles(&tris).unwrap();
-                    let mut serial = Bvh::with_capacity(tris.len());
-                    preset
-                        .build_into(Some(area), &options, &mut arena, &mut serial)
-                        .unwrap();
-                    load_triangles(&mut arena, &tris).unwrap();
-                    let threaded = build_preset(preset, Some(area), &options, &mut arena).unwrap();
-                    assert!(
-                        threaded == serial,
-                        "{preset} {area:?} {}",
-                        options.thesis_mode
-                    );
+                    for for_wide in [false, true] {
+                        let serial = BuildOptions {
+                            settings,
+                            for_wide,
+                            ..BuildOptions::new(preset)
+                        };
+                        let threaded = BuildOptions {
+                            parallel: true,
+                            ..serial
+                        };
+                        assert!(
+                            threaded.build(&tris, Some(area)) == serial.build(&tris, Some(area)),
+                            "{preset} {area:?} {} {for_wide}",
+                            settings.thesis_mode
+                        );
+                    }
                 }
             }
         }
-        let mut arena = BuildArena::with_capacity(1);
+        let full = BuildOptions {
+            parallel: true,
+            ..BuildOptions::new(Preset::Full)
+        };
         assert_eq!(
-            build_preset(Preset::Full, None, &PresetOptions::default(), &mut arena),
+            full.build(&tris, None),
             Err(PresetError::NeedsArea(Preset::Full))
         );
     }
@@ -510,42 +391,5 @@ mod tests {
             build(&sah, &tris),
             Err(BuildError::InvalidPrimitive { index: 20_000 })
         );
-    }
-
-    #[test]
-    fn threaded_scene_equals_single_threaded() {
-        let mut tris = soup(5_000);
-        // Long triangles across the soup, so that reinsertion moves something.
-        tris.extend((0..100).map(|i| {
-            let y = i as f32 * 0.2 - 10.0;
-            Triangle::new(
-                Vec3::new(-10.0, y, -10.0),
-                Vec3::new(10.0, y, 10.0),
-                Vec3::new(-10.0, y + 0.1, 10.0),
-            )
-        }));
-        let areas: Vec<InfluenceArea> = vec![
-            PlaneArea::new(Vec3::new(0.0, 0.0, -12.0), Vec3::Z, 6.0, 6.0, 20.0)
-                .unwrap()
-                .into(),
-            PointArea::new(Vec3::new(0.0, 12.0, 0.0), -Vec3::Y, 60.0, 60.0, 1.0, 20.0)
-                .unwrap()
-                .into(),
-        ];
-        let plain = TopLevelOptions::default();
-        let reinserted = TopLevelOptions {
-            reinsert: Some(ReinsertConfig::default()),
-            ..plain
-        };
-        let mut fallbacks = Vec::new();
-        for options in [plain, reinserted] {
-            let a = build_scene(&tris, areas.clone(), &options, |a| Octree::build(a, 5)).unwrap();
-            let b = TopLevel::with_octree(&tris, areas.clone(), &options, 5).unwrap();
-            assert_eq!(a.local_bvhs(), b.local_bvhs());
-            assert_eq!(a.fallback(), b.fallback());
-            fallbacks.push(a.fallback().clone());
-        }
-        // The option reaches the trees.
-        assert!(fallbacks[0] != fallbacks[1], "reinsertion changed nothing");
     }
 }

@@ -84,6 +84,29 @@ pub struct BuildStats {
 /// stack. The depth bound of [`BuildConfig::max_depth`] always holds: when
 /// `depth + ceil(log2 n)` reaches it, or when no binned plane separates a node that must split, the
 /// node is split at its object median instead.
+///
+/// The presets ([`super::BuildOptions`]) name the usual combinations; a builder of your own
+/// mixes any chooser, cost model and termination, here the orthographic PAH of rays travelling
+/// down `-y` with the longest-axis (LSPH) chooser:
+///
+/// ```
+/// use rdbvh_core::builder::BuildConfig;
+/// use rdbvh_core::heuristics::{LongestAxis, PahOrtho, SahTermination};
+/// use rdbvh_core::{Builder, Ray, Triangle, Vec3};
+///
+/// let tris: Vec<Triangle> = (0..100)
+///     .map(|i| {
+///         let o = Vec3::new((i % 10) as f32, (i / 10) as f32 * 0.1, (i / 10) as f32);
+///         Triangle::new(o, o + Vec3::X, o + Vec3::Z)
+///     })
+///     .collect();
+/// let down = PahOrtho::new(-Vec3::Y).expect("a direction");
+/// let builder = Builder::new(LongestAxis, down, SahTermination::default(), BuildConfig::default());
+/// let bvh = builder.build(&tris)?;
+/// let ray = Ray::new(Vec3::new(4.2, 5.0, 6.3), -Vec3::Y)?;
+/// assert_eq!(bvh.closest_hit(&ray, &tris).map(|h| h.triangle), Some(64));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Builder<A = AllAxes, C = Sah, T = SahTermination> {
     /// Which axes each node tries.

@@ -34,6 +34,36 @@ pub const MAX_DEPTH: u32 = 64;
 /// Only the builders make one, so its invariants hold by construction and the traversals can rely
 /// on them: children in range and adjacent, depth at most [`MAX_DEPTH`], every leaf's run inside
 /// [`Bvh::prim_indices`]. [`Bvh::validate`] checks them all.
+///
+/// A renderer that rebuilds every frame sizes the arena and the tree once and builds into them
+/// without allocating:
+///
+/// ```
+/// use rdbvh_core::builder::BuildArena;
+/// use rdbvh_core::{BuildOptions, Bvh, Preset, Ray, Triangle, Vec3};
+///
+/// let mut tris: Vec<Triangle> = (0..32)
+///     .map(|i| {
+///         let o = Vec3::new(i as f32, 0.0, 2.0);
+///         Triangle::new(o, o + Vec3::X, o + Vec3::Y)
+///     })
+///     .collect();
+/// let options = BuildOptions::new(Preset::Sah);
+/// let mut arena = BuildArena::with_capacity(tris.len());
+/// let mut bvh = Bvh::with_capacity(tris.len());
+/// for frame in 0..3 {
+///     for t in &mut tris {
+///         *t = Triangle::new(t.v0 + Vec3::Z, t.v1 + Vec3::Z, t.v2 + Vec3::Z); // the scene moves
+///     }
+///     arena.load_triangles(&tris)?;
+///     options.build_into(&mut arena, None, &mut bvh)?;
+///     let ray = Ray::new(Vec3::new(3.1, 0.1, 0.0), Vec3::Z)?;
+///     let hit = bvh.closest_hit(&ray, &tris).unwrap();
+///     assert_eq!((hit.triangle, hit.t), (3, 3.0 + frame as f32));
+///     assert!(bvh.any_hit(&ray, &tris));
+/// }
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Bvh {
     pub(crate) nodes: Vec<BvhNode>,

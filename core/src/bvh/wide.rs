@@ -70,6 +70,26 @@ impl WideNode {
 /// triangle test ([`Triangle4`] blocks: a leaf tests four triangles per step, with no indirection
 /// through a primitive-index array). The root is node 0; a BVH whose binary root becomes a leaf
 /// (see [`WideBvh::from_binary`]) gets a root with that leaf as its only child.
+///
+/// ```
+/// use rdbvh_core::{BuildOptions, Preset, Ray, Triangle, Vec3, WideBvh};
+///
+/// let tris: Vec<Triangle> = (0..50)
+///     .map(|i| {
+///         let o = Vec3::new(i as f32, 0.0, 4.0);
+///         Triangle::new(o, o + Vec3::X, o + Vec3::Y)
+///     })
+///     .collect();
+/// // A tree only to be collapsed can skip what the collapse throws away.
+/// let options = BuildOptions { for_wide: true, ..BuildOptions::new(Preset::Sah) };
+/// let wide = WideBvh::from_binary(&options.build(&tris, None)?, &tris);
+/// let ray = Ray::new(Vec3::new(7.1, 0.1, 0.0), Vec3::Z)?;
+/// assert_eq!(wide.closest_hit(&ray).map(|h| h.triangle), Some(7));
+/// // A shadow segment that stops short of the triangles.
+/// let shadow = Ray::segment(Vec3::new(7.1, 0.1, 0.0), Vec3::Z, 0.0, 3.9)?;
+/// assert!(!wide.any_hit(&shadow));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct WideBvh {
     pub(crate) nodes: Vec<WideNode>,

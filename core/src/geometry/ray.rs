@@ -40,6 +40,19 @@ impl core::error::Error for RayError {}
 /// derived from the origin and the direction, so change a ray's `origin` or `dir` by making a new
 /// one. A part of a ray, `Ray::segment(ray.origin, ray.dir, lo, hi)`, keeps its anchor and so its
 /// answers.
+///
+/// ```
+/// use rdbvh_core::{Ray, Triangle, Vec3};
+///
+/// let wall = Triangle::new(Vec3::new(-1.0, -1.0, 2.0), Vec3::new(1.0, -1.0, 2.0), Vec3::new(0.0, 1.0, 2.0));
+/// // A shadow segment toward a light at z = 4, in units of the unnormalised offset.
+/// let (p, light) = (Vec3::ZERO, Vec3::new(0.0, 0.0, 4.0));
+/// let shadow = Ray::segment(p, light - p, 0.0, 1.0 - 1e-4)?;
+/// assert_eq!(wall.intersect(&shadow, shadow.t_max).map(|h| h.t), Some(0.5));
+/// // A zero or non-finite direction is an error, not a ray.
+/// assert!(Ray::new(p, Vec3::ZERO).is_err());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
     /// Where the ray starts (at `t = 0`).

@@ -9,6 +9,20 @@ use crate::geometry::{Aabb, Frame, Obb, Polytope, Ray, Triangle};
 /// An oriented box: the light rectangle (centre `center`, half extents `half_width` along
 /// `frame.right` and `half_height` along `frame.up`) swept `depth` along the ray direction
 /// `frame.forward`.
+///
+/// ```
+/// use rdbvh_core::{PlaneArea, Ray, Vec3};
+///
+/// // A 2 x 2 area light at y = 5 facing down, its parallel rays followed 6 units.
+/// let area = PlaneArea::new(Vec3::new(0.0, 5.0, 0.0), -Vec3::Y, 1.0, 1.0, 6.0)?;
+/// assert!(area.contains(Vec3::new(0.5, 2.0, -0.5)));
+/// // Affine: starts inside and travels (almost) the area's way.
+/// assert!(area.is_affine(&Ray::new(Vec3::new(0.5, 4.0, 0.0), -Vec3::Y)?));
+/// assert!(!area.is_affine(&Ray::new(Vec3::new(0.5, 4.0, 0.0), Vec3::X)?));
+/// // A degenerate window is an error naming its key.
+/// assert!(PlaneArea::new(Vec3::ZERO, -Vec3::Y, 0.0, 1.0, 6.0).is_err());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlaneArea {
     /// Centre of the light rectangle.

@@ -14,6 +14,19 @@ const EYE_ROUNDING: f32 = 1024.0 * f32::EPSILON;
 
 /// A frustum with apex at the light (`eye`), looking along `frame.forward`, full fields of view
 /// `fov_x_deg` (along `frame.right`) and `fov_y_deg` (along `frame.up`), cut at `near` and `far`.
+///
+/// ```
+/// use rdbvh_core::{PointArea, Ray, Vec3};
+///
+/// // A spot light at y = 5 looking down with a 90 x 90 degree cone, from 0.1 to 10 units.
+/// let area = PointArea::new(Vec3::new(0.0, 5.0, 0.0), -Vec3::Y, 90.0, 90.0, 0.1, 10.0)?;
+/// assert!(area.contains(Vec3::new(1.0, 2.0, 1.0)));
+/// // Affine: starts inside and travels radially, away from the eye.
+/// let radial = Vec3::new(0.3, -1.0, 0.2);
+/// assert!(area.is_affine(&Ray::new(Vec3::new(0.0, 5.0, 0.0) + radial, radial)?));
+/// assert!(!area.is_affine(&Ray::new(Vec3::new(0.0, 5.0, 0.0) + radial, Vec3::X)?));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PointArea {
     /// Field of view along `right`, in degrees.

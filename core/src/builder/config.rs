@@ -27,7 +27,7 @@ pub struct ThesisCut {
     /// Stop trying axes once `(m(L) + m(R)) / m(parent)` is at most this (thesis: 0.9).
     pub excellent_ratio: f32,
     /// When the next axis is of too low a quality, accept the best split so far if its ratio is at
-    /// most this (thesis: 1.3); otherwise fall back to SAH on the longest axis.
+    /// most this (thesis: 1.3); otherwise take SAH on the longest axis.
     pub acceptable_ratio: f32,
     /// Axes after the first are tried only while their quality is at least this (thesis: 0.4
     /// for SPFH, 0.99 for LSPH).
@@ -58,7 +58,7 @@ pub enum CutEvaluation {
     BestOfAxes,
     /// Evaluate the chooser's first axis only.
     FirstAxis,
-    /// The thesis's cut evaluation: axes in quality order, early acceptance, SAH fallback.
+    /// The thesis's cut evaluation: axes in quality order, early acceptance, SAH on the longest axis as the last resort.
     Thesis(ThesisCut),
 }
 

@@ -1,6 +1,6 @@
 //! The thesis's cut evaluation: a priced candidate cut, and which axes' cuts a node considers
 //! (best of all axes, the first axis only, or the thesis's quality and ratio thresholds with its
-//! SAH fallback).
+//! SAH on the longest axis as the last resort).
 
 use super::config::CutEvaluation;
 use crate::geometry::Aabb;
@@ -64,7 +64,7 @@ pub(super) struct Split {
 /// Applies the cut evaluation `cut` to a node whose chooser ranked the axes `order`.
 /// `sweep(axis, false)` is the cheapest cut along `axis` under the node's model (`None` where
 /// nothing separates the primitives); `sweep(axis, true)` the cheapest under SAH, re-priced under
-/// the node's model: the thesis's fallback. Ties go to the earlier axis.
+/// the node's model: the thesis's last resort. Ties go to the earlier axis.
 pub(super) fn walk(
     cut: CutEvaluation,
     order: &AxisOrder,
@@ -100,7 +100,7 @@ pub(super) fn walk(
             }
             return match best {
                 Some(b) if b.cut.ratio(parent) <= thesis.acceptable_ratio => Some(b),
-                // Not even acceptable: SAH on the longest axis, the thesis's fallback.
+                // Not even acceptable: SAH on the longest axis, the thesis's last resort.
                 _ => sweep(largest, true)
                     .map(|cut| Split { axis: largest, cut })
                     .or(best),

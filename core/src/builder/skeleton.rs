@@ -67,7 +67,7 @@ pub struct BuildStats {
     pub leaves: u32,
     /// Depth of the deepest node.
     pub max_depth: u32,
-    /// Nodes split by the object-median fallback because the heuristic could not separate them
+    /// Nodes split at their object median because the heuristic could not separate them
     /// (all centroids equal, a zero-measure node) or the depth budget ran short.
     pub median_splits: u32,
     /// Time and calls of the orientation choice and the candidate pricing.
@@ -476,7 +476,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
     }
 
     /// The axes a node's cut evaluation sweeps: those the chooser names, its first only, or all
-    /// three (the thesis's fallback needs the longest axis whatever the chooser said).
+    /// three (the thesis's last resort, SAH on the longest axis, needs it whatever the chooser said).
     fn swept_axes(&self, order: &AxisOrder) -> [bool; 3] {
         let mut swept = [false; 3];
         match self.config.cut {

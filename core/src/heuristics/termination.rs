@@ -1,7 +1,7 @@
 //! Termination rules: when a node becomes a leaf.
 
 /// Decides when a node stops splitting. The builder also stops on its own at its depth bound, and
-/// falls back to a median split when a node must split but no binned split separates it.
+/// splits at the object median when a node must split but no binned split separates it.
 pub trait Termination {
     /// Called before any split is evaluated: `true` makes the node a leaf at once.
     fn must_stop(&self, count: u32, depth: u32) -> bool;

@@ -76,6 +76,10 @@ else
     echo "note: nm not found, symbol check not run"
 fi
 
+section "packaging (cargo publish --dry-run -p rdbvh-core)"
+# The core is the crate users link: it must package and build from its packaged sources alone.
+cargo publish --dry-run -p rdbvh-core
+
 section "fuzz (bounded: FUZZ_SECONDS=$FUZZ_SECONDS per target)"
 # cargo-fuzz needs nightly flags; RUSTC_BOOTSTRAP=1 lets this stable toolchain take them. The
 # targets run without a sanitizer (`-s none`): the core's two unsafe blocks are a read of a

@@ -97,7 +97,7 @@ fn builds(c: &mut Criterion<Clock>) {
         bench_library::<Parry>(&mut group, &pool, &tris);
         group.finish();
 
-        // PAH beside SAH (issue 6: within 1.1x), the `peers` binary's areas over the scene.
+        // PAH beside SAH (target: within 1.1x), the `peers` binary's areas over the scene.
         let b = bounds(&tris);
         let areas: Vec<(&str, Preset, Option<InfluenceArea>)> = vec![
             ("sah", Preset::Sah, None),

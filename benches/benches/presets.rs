@@ -1,9 +1,9 @@
-//! Build time of the six presets (issue 3) on the bunny and Crytek Sponza, throughput in
+//! Build time of the six presets on the bunny and Crytek Sponza, throughput in
 //! triangles: `presets/SCENE/{sah,standard}` (no area: these presets ignore it) and
 //! `presets/SCENE/{facing,longest,full}-{plane,point}` with a plane area (light rectangle just
 //! outside the scene's box, normal tilted about 13 degrees from straight down, covering the box)
 //! and a point area (eye outside the box, 90 x 90 degree frustum holding it); see
-//! `rdbvh_benches::areas`. Issue 3's targets: PAH orthographic (`longest`/`full` with the plane
+//! `rdbvh_benches::areas`. The targets: PAH orthographic (`longest`/`full` with the plane
 //! area) within 1.25x of the `sah` build time, PAH perspective (with the point area) within 2x.
 //!
 //! One thread, `PresetOptions::default()`, arena and output reused; the timed build includes

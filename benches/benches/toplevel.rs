@@ -1,4 +1,5 @@
-//! The top-level structure (issue 4).
+//! The top-level structure: the area lookup, and queries through the structure against its
+//! fallback BVH alone.
 //!
 //! `lookup/N/{list,octree-L}`: time per looked-up point of the naive area list against the octree
 //! with `L` levels, for `N` = 1 to 80 random areas (plane and point areas in turn, in a 10 x 10 x

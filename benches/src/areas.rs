@@ -1,6 +1,6 @@
 //! Influence areas for the heuristic and top-level benchmarks: a plane and a point area placed
-//! over a scene's box from an oblique side (issue 3's "areas over the scene"), and deterministic
-//! random areas for the lookup benchmark (issue 4).
+//! over a scene's box from an oblique side, and deterministic random areas for the lookup
+//! benchmark.
 
 use glam::Vec3;
 use rdbvh_core::geometry::{Aabb, Frame};

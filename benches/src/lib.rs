@@ -52,7 +52,7 @@ pub const SCENES_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/
 
 /// The scenes the benchmarks run on: the Stanford bunny (69,451 triangles, one compact closed-ish
 /// object) and Crytek Sponza (262,267 triangles, an architectural interior with large and tiny
-/// triangles mixed), the two scenes issue 2 names.
+/// triangles mixed).
 pub const BENCH_SCENES: [&str; 2] = ["bunny", "sponza_crytek"];
 
 /// The scenes directory, or why it cannot be used. Benchmarks skip (and say why) rather than fail

@@ -1,4 +1,4 @@
-//! Issue 3's evidence: on every thesis scene with its influence areas from `experiments.toml`, the
+//! PAH predicts what it models: on every thesis scene with its influence areas from `experiments.toml`, the
 //! PAH estimate of a built tree equals the measured all-hit cost of the rays PAH models, within 2%
 //! for plane areas and 3% for point areas whose sampler matches the measure (solid angle, image
 //! plane), also at a 130-degree field of view. SAH, measured the same way, is far off: PAH's

@@ -17,17 +17,13 @@ use crate::BuildError;
 ///
 /// Every loop of the build reads a primitive's whole box at once (binning grows three bins by it,
 /// the partition moves it), so the six bounds and the id share one record: two aligned loads, one
-/// 32-byte swap. A structure of arrays (seven arrays) cost the partition seven scattered swaps per
-/// moved primitive and the binning six gathers; measured with callgrind on the bunny's SAH build,
-/// this layout takes markedly fewer instructions (see the speed issue's note).
+/// 32-byte swap, where seven separate arrays would need scattered swaps and gathers.
 ///
 /// Lane 3 of each corner holds 16 of the id's bits as the mantissa of a float in `[1, 2)`
-/// ([`ID_LANE_ONE`]). The 4-wide arithmetic of the build (centroids `lo + hi`, bin indices)
-/// carries lane 3 along, and the id's raw bits would be a subnormal float there for every id
-/// below 2^23: each add or multiply on a subnormal takes a microcode assist. Measured on the
-/// bunny (AMD EPYC, Zen 4): an isolated binning loop took 10.2 ns per primitive with raw id
-/// bits and 3.5 ns with normal floats in lane 3. Lane 3 of a sum or difference of two such
-/// floats is again normal or zero, so no garbage lane turns subnormal either.
+/// ([`ID_LANE_ONE`]). The build's 4-wide arithmetic carries lane 3 along, and raw id bits would
+/// be subnormal floats there, each operation on them a slow microcode assist (measured:
+/// benches/RESULTS.md, section Build speed (single and multi thread)). Sums and differences of
+/// two such floats are again normal or zero, so no garbage lane turns subnormal either.
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(16))]
 pub(crate) struct PrimRef {

@@ -1,8 +1,7 @@
 //! Exhaustive splits for the smallest nodes: every bipartition of a node's primitives priced, not
 //! only the axis-aligned ones.
 //!
-//! Most nodes of a binned build are tiny (on the bunny, 43% of the internal nodes hold three or
-//! four primitives and most leaves hold two), and a binned node's price is fixed costs: three bin
+//! Most nodes of a binned build are tiny, and a binned node's price is fixed costs: three bin
 //! maps, clearing the bins, a pass, three sweeps of at least four bins, a partition. A node of
 //! `n <= 6` primitives has only `2^(n-1) - 1` bipartitions (7 for four primitives): the boxes of
 //! all `2^n - 1` subsets take one union each, and pricing both sides of every bipartition takes
@@ -11,11 +10,8 @@
 //! these bipartitions). Ties go to the most balanced, then the lowest mask, so the tree is a
 //! function of the input alone.
 //!
-//! The default is four primitives: the pair nodes a SAH build prices, and the three- and
-//! four-primitive nodes (29% of the bunny's inner nodes hold four). callgrind on the bunny's
-//! SAH build, with the gathers below written without closures: 164.7M instructions with three,
-//! 160.6M with four (thread time 21.7 -> 20.8 ms); an earlier version of this module measured
-//! 166.0M with five. The split found is the optimal one, and cheaper to find than a binned one.
+//! The default is four primitives: fewer build instructions than three or five
+//! (measured: benches/RESULTS.md, section Build speed (single and multi thread)).
 
 use super::arena::{lanes_to_aabb, soa, Bin, PrimRef};
 use super::config::MAX_EXHAUSTIVE;
@@ -60,9 +56,8 @@ const ORDER: [[u8; SUBSETS / 2]; MAX_EXHAUSTIVE as usize + 1] = {
 /// primitive always goes right, so each bipartition is tried once; ties go to the earliest in
 /// [`ORDER`]. `subsets` is scratch. `None` when no bipartition has a finite price.
 ///
-/// Inlined into the builder: returned through memory, the cut (two boxes and four prices) was
-/// read back at once after the call, waiting on its own stores; inlined, the SAH build took 4%
-/// less time on the bunny and Crytek Sponza (thread CPU, three interleaved rounds).
+/// Inlined into the builder: returned through memory, the cut (two boxes and four prices) would
+/// be read back at once after the call, waiting on its own stores.
 #[inline(always)]
 pub(crate) fn cheapest_bipartition<M: CostModel>(
     prims: &[PrimRef],

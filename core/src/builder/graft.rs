@@ -88,10 +88,9 @@ impl Bvh {
             max_depth = max_depth.max(sub.max_depth);
             total += sub.nodes.len() - 1;
         }
-        // The new tree is written once, node by node, into uninitialised memory. Zeroing it
-        // first (`vec![zeroed; total]`, or calloc over recycled memory) wrote every node and took
-        // every page fault on one thread: the threaded Crytek Sponza build's graft took 5.5-7 ms
-        // that way, of a 40-50 ms build, and 2.8-3.5 ms with the blocks written on two threads.
+        // The new tree is written once, node by node, into uninitialised memory: zeroing it
+        // first would write every node and take every page fault on one thread, where the blocks'
+        // writes spread them over all threads.
         let mut nodes: Vec<BvhNode> = Vec::with_capacity(total);
         let out = &mut nodes.spare_capacity_mut()[..total];
         let placed = canonical_layout(&top_nodes, &job_of, jobs, subtrees, out)?;

@@ -2,19 +2,13 @@
 //! build, sooner. [`super::BuildOptions::parallel`] runs a preset here; these functions run any
 //! [`Builder`].
 //!
-//! A binary build is split where subtrees get small: the core builds the top of the tree on one
-//! thread and hands over each node of at most `cutoff` primitives as a job the moment it reaches
-//! it ([`Builder::build_top_into`]); rayon builds the jobs on all threads while the top goes on,
-//! the largest waiting first, each over its own arena at its own depth and with its root's
-//! measure as the top priced it ([`Builder::build_subtree_into`]); [`Bvh::graft_with`] splices
-//! them in and re-lays the nodes out in the single-threaded order, copying on all threads. The
-//! result is the single-threaded tree node for node, which the tests check. Scenes build their
-//! local BVHs and the fallback BVH concurrently.
-//!
-//! The serial part is kept small: the triangle bounds are loaded in parallel parts
-//! ([`BuildArena::load_triangles_with`]), and the top nodes, each a pass over many primitives,
-//! are binned in parallel parts ([`Builder::build_top_with`]); bins merge exactly, so neither
-//! changes the tree.
+//! One thread builds the top of the tree and hands over each node of at most `cutoff` primitives
+//! as a job the moment it reaches it ([`Builder::build_top_into`]); rayon builds the jobs on all
+//! threads meanwhile, largest first ([`Builder::build_subtree_into`]), and [`Bvh::graft_with`]
+//! splices them in, in the single-threaded order. The result is the single-threaded tree node
+//! for node. The serial part is kept small: triangle loading
+//! ([`BuildArena::load_triangles_with`]) and the top nodes' binning ([`Builder::build_top_with`])
+//! run in parallel parts, which merge exactly.
 
 use alloc::collections::BinaryHeap;
 use alloc::vec::Vec;
@@ -33,9 +27,7 @@ use crate::heuristics::{AxisChooser, CostModel, Termination};
 use crate::BuildError;
 
 /// Jobs per thread: enough that uneven subtrees still balance across threads, few enough that
-/// the top (whose partitions run on one thread) stays shallow. On 2 threads, 4 beat 16 and 2
-/// (bunny 13.9-15.0 ms against 15.2-16.2 and 14.4-14.8; Sponza 61.0-63.2 against 61.0-70.7 and
-/// 65.1-66.6, wall, best of 11, two rounds, load 1.5-2.1).
+/// the top (whose partitions run on one thread) stays shallow; 4 was faster than 2 and 16.
 const JOBS_PER_THREAD: usize = 4;
 
 /// The smallest subtree worth a job of its own: below this, scheduling costs more than it saves.
@@ -198,10 +190,8 @@ impl Eq for Pending {}
 /// builds instead of preceding them all.
 ///
 /// Each job spawned is a ticket, not a subtree: the task that runs takes the largest job waiting
-/// then (longest job first). Taken in rayon's order instead (the order the top reached them), a
-/// large subtree could start last and run alone at the end: on Crytek Sponza, one thread idled
-/// 11 ms of a 57 ms build while the other finished a 32k-triangle job; largest first, the two
-/// threads finished within 0.2-0.6 ms of each other.
+/// then (longest job first), so a large subtree never starts last and runs alone at the end while
+/// the other threads idle.
 struct Spawner<'scope, 'env, A, C, T> {
     scope: &'env rayon::Scope<'scope>,
     builder: &'scope Builder<A, C, T>,

@@ -6,8 +6,8 @@
 //! rest; swapping the k-th of the first (from the front) with the k-th of the second (from the
 //! back) gives exactly the permutation of Hoare's scheme, which scans from both ends and swaps
 //! the pairs it stops at. Hoare's scans branch on every primitive's side, and the sides of a
-//! node's primitives are as good as random to the branch predictor: on the bunny's SAH build the
-//! partition ran 15% of the instructions but took 32% of the time (perf, cpu-clock samples).
+//! node's primitives are as good as random to the branch predictor, so those branches mispredict
+//! often.
 //!
 //! Here each side is scanned in blocks of [`BLOCK`] slots, writing the offset of every slot and
 //! advancing a count by whether it is misplaced (no branch), then the misplaced pairs are
@@ -107,8 +107,8 @@ mod tests {
     use crate::random::Pcg32;
     use glam::Vec3;
 
-    /// Hoare's scheme as the builder ran it before: scan from the front past left-goers, from the
-    /// back past right-goers, swap the two slots the scans stopped at.
+    /// Hoare's scheme, the reference: scan from the front past left-goers, from the back past
+    /// right-goers, swap the two slots the scans stopped at.
     fn hoare(slots: &mut [PrimRef], goes_left: impl Fn(&PrimRef) -> bool) -> usize {
         let (mut i, mut j) = (0, slots.len());
         loop {

@@ -27,9 +27,8 @@ pub enum Preset {
     /// PAH over all three axes: `sah`'s builder (every axis binned, the cheapest cut of all,
     /// exhaustive small nodes) pricing with the area's PAH instead of SAH. Not one of the
     /// thesis's pairs: SPFH and LSPH save sweeps by trusting one axis, this prices all three, so
-    /// its trees have the lowest PAH cost of the presets on each of the thesis's 48
-    /// configurations with a published scene (0.90x `full`'s on the geometric mean; Crytek
-    /// Sponza: 0.72x), for about the build time of `full`.
+    /// its trees have the lowest PAH cost of the presets, for about the build time of `full`
+    /// (measured: benches/RESULTS.md, section Heuristic quality (SAH/PAH cost of the presets)).
     Pah,
 }
 
@@ -202,8 +201,9 @@ impl From<BuildError> for PresetError {
 impl Preset {
     /// Hands `visitor` the builder this preset names for `area` and `options`, statically
     /// dispatched: how [`super::BuildOptions`] runs a preset on one thread or on every thread,
-    /// and how a caller runs one its own way, without a second copy of which chooser, cost model and termination each preset
-    /// takes. `area` is required for `facing`, `longest`, `full` and `pah`.
+    /// and how a caller runs one its own way, without a second copy of which chooser, cost
+    /// model and termination each preset takes. `area` is required for `facing`, `longest`,
+    /// `full` and `pah`.
     pub fn with_builder<V: PresetVisitor>(
         self,
         area: Option<&InfluenceArea>,

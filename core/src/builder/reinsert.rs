@@ -5,8 +5,7 @@
 //! "Fast insertion-based optimization of bounding volume hierarchies", 2013) takes the nodes of
 //! largest measure, removes each from the tree (its sibling takes its parent's place) and puts it
 //! back as the sibling of the node where it adds the least cost, found by branch and bound from
-//! the root. It is the pass that lets PLOC-style builders (obvhs's, say) beat a binned SAH tree on
-//! scenes of long, overlapping triangles such as Crytek Sponza.
+//! the root. It matters most on scenes of long, overlapping triangles.
 //!
 //! Leaves move whole: their primitives and boxes never change, so a tree's cost
 //! (`C_trav * sum of inner measures + C_isect * sum of leaf measures x counts`, over the root's)
@@ -51,9 +50,9 @@ pub struct ReinsertConfig {
 
 impl Default for ReinsertConfig {
     /// 2% of the nodes per pass, at most 3 passes, stop below a 0.1% gain, depth up to
-    /// [`MAX_DEPTH`]. Chosen by the 4-wide traversal cost over eleven views of Crytek Sponza and
-    /// Sibenik (`benches/examples/reinsert.rs`; numbers in `benches/RESULTS.md`): 0.75 and 0.80
-    /// of the unoptimized tree's, where 1% and 2 passes gave 0.87 and 0.85.
+    /// [`MAX_DEPTH`]: the best 4-wide traversal cost of the settings compared (measured:
+    /// benches/RESULTS.md, section Tree quality for traversal: reinsertion and the 4-wide
+    /// collapse).
     fn default() -> Self {
         Self {
             fraction: 0.02,
@@ -210,8 +209,7 @@ impl Reinserter {
         self.parent.resize(n, NONE);
         self.children.clear();
         self.children.resize(n, [NONE; 2]);
-        // Reserved whole, not grown by doubling: on the bunny (75k nodes) the growth's copies
-        // were a fifth of reinsertion's instructions.
+        // Reserved whole, not grown by doubling: the growth's copies are costly on large trees.
         self.bounds.clear();
         self.bounds.reserve(n);
         self.measure.clear();
@@ -245,8 +243,7 @@ impl Reinserter {
     ///
     /// A histogram of the measures' top bits finds the bucket the last candidate falls in, and
     /// only the nodes from that bucket up are collected and ordered: the same nodes, in the same
-    /// order, as ordering them all. On Crytek Sponza (262k nodes) selecting among all of them
-    /// took a quarter of reinsertion's instructions.
+    /// order, as ordering them all, at a fraction of the cost on large trees.
     fn pick(&mut self, fraction: f32) {
         self.candidates.clear();
         let root = self.root as usize;
@@ -520,7 +517,6 @@ mod tests {
         check(&bvh, &tris);
         let k = CostConstants::default();
         let (before, after) = (built.estimated_cost(&Sah, k), bvh.estimated_cost(&Sah, k));
-        // Measured: 50.0 -> 47.1, 78 of 366 tried nodes moved.
         assert!(
             stats.moved > 0 && after < 0.98 * before,
             "{stats:?}: {before} -> {after}"
@@ -658,8 +654,8 @@ mod tests {
     fn padding_and_rounding_never_raise_the_cost() {
         // A node's padding is relative to its largest coordinate: one triangle far along x gives
         // the root a padding that its children near the origin lack, so a root refitted to
-        // their union would shrink and raise every cost ratio (found by the fuzzer,
-        // `fuzz/regressions/build_query/crash-cf4ce86c...`).
+        // their union would shrink and raise every cost ratio
+        // (`fuzz/regressions/build_query/crash-cf4ce86c...`).
         let mut tris = crate::test_scenes::soup(300, 12, -0.5, 0.5, 0.2);
         let x = Vec3::new(300.0, 0.0, 0.0);
         tris.push(Triangle::new(x, x + Vec3::Y * 0.1, x + Vec3::Z * 0.1));

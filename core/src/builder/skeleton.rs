@@ -169,17 +169,12 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
 
     /// The same builder for a tree that will only be collapsed into a [`WideBvh`]: nodes of at
     /// most [`WideBvh::ONE_BLOCK`] primitives are leaves at once ([`MinLeaf`]), since the collapse
-    /// makes each such subtree one leaf block whatever is below it. The build decides every larger
-    /// node as before (a node's split depends on its primitives alone), so
-    /// [`WideBvh::from_binary`] of its tree has the same nodes as that of this builder's tree, with
-    /// the same triangles in each leaf (a leaf of two blocks may group them otherwise). It skips
-    /// the nodes below: 43% of the bunny's binary nodes and 40% of Crytek Sponza's, 18-22% of the
-    /// build's instructions.
-    ///
-    /// [`crate::builder::reinsert`] on the smaller tree can only move its four-triangle leaves as
-    /// units, and gives another wide tree: as cheap to traverse on the bunny and Crytek Sponza,
-    /// 8% costlier on Sibenik. Reinsert the full build's tree when the wide tree is to be
-    /// improved.
+    /// makes each such subtree one leaf block anyway. Every larger node splits as before, so
+    /// [`WideBvh::from_binary`] gives the same nodes as for this builder's tree, with the same
+    /// triangles in each leaf (a leaf of two blocks may group them otherwise), for about a fifth
+    /// less build work (measured: benches/RESULTS.md, section Build speed (single and multi
+    /// thread)). [`crate::builder::reinsert`] can only move this tree's small leaves as units:
+    /// reinsert the full build's tree when the wide tree is to be improved.
     pub fn for_wide(self) -> Builder<A, C, MinLeaf<T>> {
         Builder {
             axes: self.axes,
@@ -267,7 +262,7 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
 
     /// [`Builder::build_top_with`] handing each subtree to `sink` the moment the top leaves it,
     /// with the arena its primitives are in: a threaded host copies them out and starts building
-    /// the subtree while the top goes on, so the top's partitions no longer run alone. The top
+    /// the subtree while the top goes on, so the top's partitions do not run alone. The top
     /// never touches a handed-over subtree's slots again.
     pub fn build_top_into(
         &self,
@@ -454,10 +449,9 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
 
     /// Bins for a node of `count` primitives. Centroid bins adapt to small nodes (`count / 2`
     /// bins, at least 4): a sweep's cost grows with its bins, small nodes are most of the tree,
-    /// and bins for more than half the centroids mostly add empty or near-duplicate boundaries.
-    /// Measured on the bunny's and Sponza's SAH builds against `count` bins: 8.5% and 7.6% fewer
-    /// instructions, SAH cost 31.4419 -> 31.4467 and 76.4883 -> 76.5077 (+0.02%). Node-box
-    /// planes stay as configured, as the thesis placed them.
+    /// and bins for more than half the centroids mostly add empty or near-duplicate boundaries
+    /// (the SAH cost moves by 0.02%; measured: benches/RESULTS.md, section Build speed (single and
+    /// multi thread)). Node-box planes stay as configured, as the thesis placed them.
     #[inline]
     fn bins_for(&self, count: u32) -> u32 {
         match self.config.bin_space {
@@ -523,9 +517,8 @@ impl<A: AxisChooser, C: CostModel, T: Termination> Builder<A, C, T> {
         let nb = self.bins_for(task.count);
         let (cut, largest) = (self.config.cut, bounds.largest_axis());
         if task.count == 2 && self.config.bin_space == BinSpace::Centroids {
-            // Every axis that separates the two centroids prices the same split, and the walk
-            // keeps the first it is offered: once one axis has found it, offering it again for
-            // the later axes changes nothing and saves pricing it again. No binning needed.
+            // Every separating axis prices the same split and the walk keeps the first, so one
+            // axis suffices. No binning needed.
             let t0 = clock.now_ns();
             let mut found = None;
             let split = walk(cut, &order, parent, largest, |axis, sah| {
@@ -727,10 +720,9 @@ mod tests {
         assert!(bvh.max_depth() <= 10, "depth {}", bvh.max_depth());
     }
 
-    /// Found by the `build_query` fuzz target: two triangles near +-f32::MAX whose doubled
-    /// centroids overflow to +-inf, so the bin scale rounds to zero and both fall in bin 0. The
-    /// two-primitive shortcut assumed the first and the last bin, put both primitives on the left
-    /// and gave the left child the other primitive's box.
+    /// Two triangles near +-f32::MAX whose doubled centroids overflow to +-inf, so the bin scale
+    /// rounds to zero and both fall in bin 0: the two-primitive shortcut must not assume they sit
+    /// in the first and the last bin (a `build_query` fuzz case).
     #[test]
     fn two_primitives_sharing_a_bin_are_not_split_by_it() {
         // Thin in y and z, so the node's surface area stays finite while the centroids'
@@ -835,11 +827,9 @@ mod tests {
             let offset = [0.0, 1e3, -1e5, 3e7, 1e30][round % 5];
             let lo = offset + rng.range(-10.0, 10.0);
             let hi = [lo + rng.range(1e-4, 20.0), lo + 1e-30, f32::MAX][round % 3];
-            // Every seventh round, a range near the smallest normal floats, where the scale is
-            // finite but the byte-scaled one would overflow. Found by `build_query` (kept in
-            // `fuzz/regressions/build_query/`): the binning put a subnormal centroid in the last
-            // bin and the partition in the first, so a child's count and box disagreed with
-            // its slots (the partition's debug assertion caught it).
+            // Every seventh case, a range near the smallest normal floats, where the scale is
+            // finite but the byte-scaled one would overflow, so binning and partition could put a
+            // subnormal centroid in different bins (`fuzz/regressions/build_query/`).
             let (lo, hi) = if round % 7 == 6 {
                 let lo = [0.0, 1e-38, -2e-38, 1e-40][round % 4];
                 (lo, lo + [1e-36, 1e-37, 2.35e-38, 1e-39][(round / 7) % 4])
@@ -886,20 +876,15 @@ mod tests {
 
     #[test]
     fn a_sweep_prices_the_same_whatever_an_earlier_sweep_left() {
-        // A sweep prices a node the same whatever an earlier, wider sweep left in the lanes past
-        // its last boundary. It once did not: perspective PAH chose its rule (far-field or
-        // exact) per group of four, and a stale near box there made a fresh arena (a threaded
-        // job's) and a reused one (the single-threaded build's) price the same boundaries a few
-        // ulps apart. The padding is now emptied and the rule chosen per lane; either alone
-        // keeps this test passing.
+        // Stale lanes past the last boundary must not change a price, or a fresh arena (a
+        // threaded job's) and a reused one (the single-threaded build's) would build different
+        // trees. Emptied padding and a per-lane rule choice each keep this passing.
         use crate::heuristics::{PahPerspective, PerspectiveMeasure};
         use crate::influence::PointArea;
         let area = PointArea::new(Vec3::ZERO, Vec3::Z, 60.0, 60.0, 0.1, 1e4).unwrap();
         let pah = PahPerspective::for_area(&area, PerspectiveMeasure::SolidAngle);
-        // Four bins in a row 1e3 ahead: each candidate box is far (half-diagonal under 1% of its
-        // distance: the far-field rule), but the node as a whole is not quite, so no hint
-        // settles it and each lane decides. And a box near the eye (exact) to leave
-        // behind.
+        // Four bins 1e3 ahead: each candidate box is far-field but the node is not, so each
+        // lane decides; and a box near the eye (exact) to leave behind.
         let bins: [Bin; 4] = core::array::from_fn(|i| {
             let lo = Vec3::new(i as f32 * 4.975 - 9.95, -0.01, 1e3);
             let hi = lo + Vec3::new(4.975, 0.02, 0.02);

@@ -14,7 +14,7 @@ use wide::f32x4;
 /// then priced four at a time with [`CostModel::measure4`]. O(bins), no allocation.
 ///
 /// The usual bin counts get a copy each with the count a constant, so the passes unroll without
-/// bounds checks; most nodes are small, and there this loop overhead was most of the sweep.
+/// bounds checks; most nodes are small, and there this loop overhead is most of the sweep.
 pub(super) fn sweep_axis<M: CostModel>(
     bins: &[Bin],
     sweep: &mut Sweep,
@@ -61,9 +61,7 @@ pub(super) fn sweep_any<M: CostModel>(
     }
     // Lanes past the last boundary, up to the end of its group of four: empty on both sides, so
     // they price as +inf (no primitive on the right) and never hold a box left by an earlier,
-    // wider sweep. Models measure each lane alone (`CostModel::measure4`), but a stale box is
-    // still measured: perspective PAH once chose its rule per group, and a stale box made a
-    // reused arena and a fresh one (a threaded job's) price the same node a few ulps apart.
+    // wider sweep, which a reused arena and a fresh one (a threaded job's) would not share.
     for i in nb..=(nb - 1).div_ceil(4) * 4 {
         sweep.left.set(i, &Bin::EMPTY);
         sweep.right.set(i, &Bin::EMPTY);

@@ -88,8 +88,8 @@ impl ConvexPolygon {
     }
 
     /// Shoelace area (zero for fewer than three vertices), as a fan from the first vertex in
-    /// f64, where differences of f32 coordinates are exact: about the origin in f32, a unit
-    /// square 1e4 away summed terms of 1e8 and kept none of its own area's bits.
+    /// f64, where differences of f32 coordinates are exact (about the origin in f32, a unit
+    /// square 1e4 away would sum terms of 1e8 and keep none of its own area's bits).
     pub fn area(&self) -> f32 {
         let p = self.points();
         if p.len() < 3 {
@@ -169,8 +169,8 @@ impl ConvexPolygon {
     /// In f64, where products of f32 coordinates are exact, and from the foot, where `a . b = 1`:
     /// the denominator is then `(bc + b . c) + b + c`, and its one cancelling part, `bc + b . c`
     /// for `b` and `c` on opposite sides of the foot, is taken as `|b x c|^2 / (bc - b . c)`. A fan
-    /// from a vertex, in f32, cancelled terms of `x^3` for vertices `x` windows out: a window
-    /// of 179.99 by 1 degrees (`x` about 11,000) measured 180 times its own solid angle.
+    /// from a vertex, in f32, would cancel terms of `x^3` for vertices `x` windows out, which
+    /// nearly flat windows reach.
     pub fn solid_angle_on_image_plane(&self) -> f32 {
         let p = self.points();
         if p.len() < 3 {
@@ -259,9 +259,8 @@ mod tests {
 
     /// Rectangles `[x1, x2] x [y1, y2]` on the image plane against the closed form
     /// `sum +-atan(x y / sqrt(1 + x^2 + y^2))` over their corners, in f64: windows up to 179.999
-    /// degrees wide (found by black-box testing: a 179.99 by 1 degree light's window measured 180
-    /// times its solid angle), and small rectangles far from the foot, where the fan's signed
-    /// triangles cancel.
+    /// degrees wide, and small rectangles far from the foot, where the fan's signed triangles
+    /// cancel.
     #[test]
     fn solid_angle_of_wide_and_far_rectangles() {
         let f = |x: f64, y: f64| libm::atan(x * y / libm::sqrt(1.0 + x * x + y * y));

@@ -35,10 +35,10 @@ pub const MIN_RELATIVE_DEPTH: f32 = 1.0 / (1u32 << 20) as f32;
 ///
 /// The cut is at least [`MIN_RELATIVE_DEPTH`] times the box's largest eye-relative coordinate
 /// from the eye, so no projected point lies farther than `1 / MIN_RELATIVE_DEPTH` from the axis
-/// and the hull's arithmetic stays far from overflow however small `near` is (0 included). That
-/// floor follows the box, not the frustum's depth: a floor from `far` once cut away a whole
-/// scene 0.3 units from the eye of a frustum 3e5 deep. It changes the silhouette only when the
-/// eye lies within that fraction of the box's size from the box.
+/// and the hull's arithmetic stays far from overflow however small `near` is (0 included). The
+/// floor follows the box, not the frustum's depth (a floor from `far` would cut away small scenes
+/// near the eye of a deep frustum), and changes the silhouette only when the eye lies within that
+/// fraction of the box's size from the box.
 pub fn perspective_silhouette(b: &Aabb, eye: Vec3, frame: &Frame, near: f32) -> ConvexPolygon {
     let local: [Vec3; 8] = core::array::from_fn(|i| frame.to_local(box_corner(b, i) - eye));
     let reach = local
@@ -119,10 +119,8 @@ pub fn windowed_silhouette(
 /// between `near` and `far`: the part of a box between the two planes is convex, so its
 /// silhouette is, and holding the corners it holds the whole window. Slab tests in 3D and in
 /// f64, where the corner directions keep the window's width beside `forward` (1e-10 of it for a
-/// light of 1e-8 degrees). Clipping the projected hull to such a window cannot decide this:
-/// found by black-box testing, the teapot seen through a 1e-8 degree window measured 8% of it,
-/// since the hull's f32 vertices, about one window-width of the scene out, place its edges to
-/// 6e-8.
+/// light of 1e-8 degrees). Clipping the projected hull to such a window cannot decide this: the
+/// hull's f32 vertices place its edges only to about 6e-8, far coarser than the window.
 fn covers_window(b: &Aabb, eye: Vec3, frame: &Frame, depth: (f32, f32), tan: Vec2) -> bool {
     let wide = |v: Vec3| [v.x, v.y, v.z].map(f64::from);
     let (right, up, forward, eye) = (
@@ -156,8 +154,8 @@ fn covers_window(b: &Aabb, eye: Vec3, frame: &Frame, depth: (f32, f32), tan: Vec
 
 /// How far from the axis, in windows, projected points may lie for [`windowed_silhouette`] to
 /// clip after projecting: the clip's rounding is then bounded by about `4096 * 2^-24` (2.4e-4)
-/// of the window, and stays under 1e-5 of the measure in the tests. Boxes past it are rare (they
-/// reach the eye's plane beside the eye), and the 3D clip costs several hull clips.
+/// of the window. Boxes past it are rare (they reach the eye's plane beside the eye), and the 3D
+/// clip costs several hull clips.
 pub const PRECISE_SPAN: f32 = 4096.0;
 
 /// The perspective silhouette of the part of `b` at depths `depth = (near, far)` in front of the

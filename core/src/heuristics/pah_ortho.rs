@@ -12,9 +12,8 @@ use super::CostModel;
 
 /// The light rectangle in its own `(right, up)` coordinates about its centre `origin`: boxes are
 /// taken relative to the centre before they are projected, so a small window far from the world
-/// origin keeps its precision (projected world coordinates round at `|centre| * 2^-24`, which a
-/// window a few 1e-7 across at 0.3 units from the origin cannot afford). The rays start on it and
-/// stop `depth` along `frame.forward`: only the part of a box in that slab can be hit.
+/// origin keeps its precision (projected world coordinates round at `|centre| * 2^-24`). The
+/// rays start on it and stop `depth` along `frame.forward`: only a box's part in that slab counts.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Window {
     origin: Vec3,
@@ -244,9 +243,8 @@ impl CostModel for PahOrtho {
     }
 
     /// With the whole node inside the window, the closed form alone (zero for empty lanes).
-    /// Otherwise the window test, out of line: inlined, its code sat in every sweep loop and
-    /// cost the hinted sweeps (most of a build's) 7% more instructions than SAH's, although only
-    /// the few nodes straddling the window's border take it.
+    /// Otherwise the window test, out of line: only the few nodes straddling the window's border
+    /// take it, and inlined it would slow every sweep loop.
     #[inline(always)]
     fn measure4_hinted(&self, b: &Aabb4, hint: u32) -> f32x4 {
         if hint == 0 {
@@ -335,10 +333,9 @@ mod tests {
         }
     }
 
-    /// Rays start on the light's plane and stop at its depth (found by black-box testing: an
-    /// oblique plane area 23.5 deep ending inside the teapot had its PAH estimate 12.6% above
-    /// the measured cost): a box reaching across either plane measures as its part between
-    /// them, as sampled rays find it; a box behind the light or past its depth, nothing.
+    /// Rays start on the light's plane and stop at its depth: a box reaching across either plane
+    /// measures as its part between them, as sampled rays find it; a box behind the light or past
+    /// its depth, nothing.
     #[test]
     fn boxes_are_cut_to_the_slab_the_rays_cross() {
         use crate::influence::{InfluenceArea, RaySampler};

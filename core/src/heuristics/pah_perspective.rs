@@ -48,8 +48,8 @@ pub struct PahPerspective {
 }
 
 /// The model's constants splatted to 4-wide lanes once, not per call: a sweep measures hundreds
-/// of thousands of box groups, and re-splatting some forty constants each time cost more than
-/// a sixth of the measure.
+/// of thousands of box groups, and re-splatting some forty constants would be a large share of
+/// each measure.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Lanes {
     eye: [f32x4; 3],
@@ -152,11 +152,10 @@ impl PahPerspective {
 
     /// Which lanes of `b` lie wholly beyond the near plane and, when culling, wholly inside the
     /// fields of view and before the far plane (such a box never contains the eye, since the
-    /// near distance is positive).
-    /// For each bounding plane of the pyramid (normal `n`, through the eye) the box's farthest
-    /// point along `n`, `n . (c - eye) + sum |n_k| h_k`, must be on the inner side. Empty and NaN
-    /// lanes fail every comparison, so they are never inside.
-    /// `c` and `h` are the boxes' eye-relative centres and half extents.
+    /// near distance is positive): for each bounding plane (normal `n`, through the eye) the
+    /// box's farthest point along `n`, `n . c + sum |n_k| h_k`, must be on the inner side, with
+    /// `c` and `h` the eye-relative centres and half extents. Empty and NaN lanes fail every
+    /// comparison, so they are never inside.
     #[inline(always)]
     fn inside_pyramid4(&self, c: &[f32x4; 3], h: &[f32x4; 3]) -> f32x4 {
         let l = &self.lanes;
@@ -449,9 +448,7 @@ mod tests {
         // A box behind the eye is never hit.
         let behind = Aabb::new(Vec3::new(-1.0, -1.0, -3.0), Vec3::new(1.0, 1.0, -2.0));
         assert_eq!(sa.measure(&behind), 0.0);
-        // Nearly flat windows (found by black-box testing: a box around the eye of a 179.99 by
-        // 1 degree light measured 180 windows, so a one-leaf tree's PAH cost read 540 for 3
-        // triangles), and the boxes of the scene that showed it.
+        // Nearly flat windows: a box holding the eye measures one window, not many.
         for (fx, fy, near) in [
             (179.99, 1.0, 0.0),
             (1.0, 179.999, 0.0),
@@ -468,9 +465,8 @@ mod tests {
             let part = sa.measure(&wall);
             assert!(part > 0.0 && part < w, "{fx} x {fy}: {part} against {w}");
         }
-        // Nearly closed windows (found by black-box testing: a light of 1e-8 degrees aimed at
-        // the teapot measured its box as 8% of the window, a one-leaf tree's cost 0.15 for 2
-        // triangles): a box across the axis covers the whole window, one beside it none.
+        // Nearly closed windows (1e-8 degrees): a box across the axis covers the whole window,
+        // one beside it none.
         for fov in [1e-6, 1e-8, 1e-13] {
             let eye = Vec3::new(3.0, 1.0, -30.0);
             let a = PointArea::new(eye, Vec3::new(0.01, 0.02, 1.0), fov, fov, 0.0, 60.0).unwrap();
@@ -492,9 +488,8 @@ mod tests {
         }
     }
 
-    /// Rays stop at the far plane (found by black-box testing: with `far` cutting through the
-    /// teapot, the PAH estimate ran 5-17% above the measured cost): a box reaching past it
-    /// measures as its part before it, and a box wholly past it as nothing.
+    /// Rays stop at the far plane, so a box reaching past it measures as its part before it, and
+    /// a box wholly past it as nothing (otherwise the estimate overstates the traced cost).
     #[test]
     fn boxes_are_cut_at_the_far_plane() {
         use crate::influence::InfluenceArea;
@@ -593,7 +588,7 @@ mod tests {
     #[test]
     fn the_frustum_depth_and_a_zero_near_do_not_cut_boxes_beyond_near() {
         // A frustum's far distance bounds where its rays go, not what its measure may ignore: a
-        // floor on the cut from `far` once zeroed every box of a scene 0.3 from the eye.
+        // cut floored relative to `far` would zero every box of a scene 0.3 from the eye.
         let eye = Vec3::new(-0.017, 0.11, 0.3);
         let area = |near: f32, far: f32| PointArea::new(eye, -Vec3::Z, 60.0, 60.0, near, far);
         let mut rng = crate::random::Pcg32::new(9);

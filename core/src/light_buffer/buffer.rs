@@ -28,10 +28,9 @@ pub struct LightBufferOptions {
     pub reference_budget: f32,
 }
 
-/// The defaults trade lookups for memory: on Sponza with a point light in the atrium, depth 4
-/// (16 x 16 cells a face) and leaves of 64 triangles take 1.4 references per triangle and cut a
-/// camera-ordered shadow ray's node and triangle tests by two thirds, where depth 6 and leaves of 8
-/// take 2.9 and cut a little more, but lose on incoherent rays to cache misses in a larger forest.
+/// The defaults (depth 4, 16 x 16 cells a face; leaves of 64 triangles) trade lookups for
+/// memory: finer grids with smaller leaves cut a little more work per ray, for twice the
+/// references, and lose on incoherent rays to cache misses in a larger forest.
 impl Default for LightBufferOptions {
     fn default() -> Self {
         Self {

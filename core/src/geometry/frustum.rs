@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 
-use super::{Frame, Plane, Polytope};
+use super::{Frame, Plane, PlaneLanes, Polytope};
 
 /// A truncated rectangular pyramid with apex `eye`: local points `(x, y, z)` of the frame with
 /// `near <= z <= far`, `|x| <= z tan_x`, `|y| <= z tan_y`.
@@ -104,6 +104,8 @@ impl Frustum {
             ],
             edge_count: 6,
             scale,
+            normal_lengths: Polytope::lengths_of(&planes),
+            lanes: PlaneLanes::new(&planes, &Polytope::lengths_of(&planes)),
         }
     }
 }

@@ -15,7 +15,7 @@ mod triangle4;
 
 pub(crate) use aabb::pad_far;
 pub use aabb::Aabb;
-pub use convex::{Plane, Polytope};
+pub use convex::{Plane, PlaneLanes, Polytope};
 pub use frame::Frame;
 pub use frustum::Frustum;
 pub use obb::Obb;

@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 
-use super::{Frame, Plane, Polytope};
+use super::{Frame, Plane, PlaneLanes, Polytope};
 
 /// A box with its own orthonormal frame: centre, axes (`right`, `up`, `forward`) and half extents
 /// along them.
@@ -58,6 +58,8 @@ impl Obb {
             ],
             edge_count: 3,
             scale,
+            normal_lengths: Polytope::lengths_of(&planes),
+            lanes: PlaneLanes::new(&planes, &Polytope::lengths_of(&planes)),
         }
     }
 }

@@ -68,15 +68,11 @@ impl InfluenceArea {
     }
 
     /// Whether this area (whose `self.bounds().padded()` is `bounds`) takes triangle `tri` into
-    /// its local BVH: a cheap box test first, then the separating-axis test. The box test uses
-    /// the padded boxes the BVH nodes use, so it never rejects a triangle whose hits a BVH
-    /// reports; the separating-axis test is conservative by a relative 1e-5 of the larger
-    /// coordinate magnitude of the area's corners and the triangle's
-    /// ([`crate::geometry::Polytope::overlaps_triangle`]), so it never drops a triangle the area
-    /// touches, and for a very large area (a 179-degree frustum reaching 1e5 units has corners
-    /// near 1e7) it also takes triangles within that margin of it: more work, never a different
-    /// answer. Every command and the experiment runner select an area's triangles by this one
-    /// test.
+    /// its local BVH: a test of the padded boxes the BVH nodes use, then the separating-axis test
+    /// ([`crate::geometry::Polytope::overlaps_triangle`], conservative by a relative 1e-5 of the
+    /// larger coordinate magnitude). Neither drops a triangle the area touches; a very large area
+    /// also takes triangles within that margin: more work, never a different answer. Every
+    /// command and the experiment runner select an area's triangles by this one test.
     #[inline]
     pub fn takes_triangle(&self, bounds: &Aabb, tri: &Triangle) -> bool {
         !tri.bounds().padded().intersection(*bounds).is_empty() && self.overlaps_triangle(tri)
@@ -87,6 +83,17 @@ impl InfluenceArea {
         match self {
             InfluenceArea::Plane(a) => a.is_affine(ray),
             InfluenceArea::Point(a) => a.is_affine(ray),
+        }
+    }
+
+    /// The part of the segment inside the area, `[t0, t1]`, when the ray is affine; `None` when it
+    /// is not or the segment misses the area. Equal to [`InfluenceArea::is_affine`] followed by
+    /// the clip to the area's polytope, in one pass: the scene's per-ray test.
+    #[inline]
+    pub fn affine_clip(&self, ray: &Ray) -> Option<(f32, f32)> {
+        match self {
+            InfluenceArea::Plane(a) => a.affine_clip(ray),
+            InfluenceArea::Point(a) => a.affine_clip(ray),
         }
     }
 

@@ -138,10 +138,26 @@ impl PlaneArea {
 
     /// Affinity: the origin is inside and the direction is within the tolerance of the normal.
     pub fn is_affine(&self, ray: &Ray) -> bool {
+        self.along_rays(ray) && self.contains(ray.origin)
+    }
+
+    /// The part of the segment inside the box when the ray is affine ([`PlaneArea::is_affine`]),
+    /// else `None`: the affinity test and the clip in one pass over the box's planes.
+    #[inline]
+    pub fn affine_clip(&self, ray: &Ray) -> Option<(f32, f32)> {
+        if !self.along_rays(ray) {
+            return None;
+        }
+        self.polytope.clip_ray_from_inside(ray)
+    }
+
+    /// The direction half of affinity: within the tolerance of the area's direction.
+    #[inline]
+    fn along_rays(&self, ray: &Ray) -> bool {
         let Some(d) = ray.dir.try_normalize() else {
             return false;
         };
-        d.dot(self.frame.forward) >= self.cos_tolerance && self.contains(ray.origin)
+        d.dot(self.frame.forward) >= self.cos_tolerance
     }
 }
 

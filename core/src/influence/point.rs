@@ -146,6 +146,23 @@ impl PointArea {
     /// whose `near` is 0 or tiny start there), the direction from the eye means nothing: a ray
     /// that leaves the eye through the window is radial.
     pub fn is_affine(&self, ray: &Ray) -> bool {
+        self.radial(ray) && self.contains(ray.origin)
+    }
+
+    /// The part of the segment inside the frustum when the ray is affine
+    /// ([`PointArea::is_affine`]), else `None`: the affinity test and the clip in one pass over
+    /// the frustum's planes.
+    #[inline]
+    pub fn affine_clip(&self, ray: &Ray) -> Option<(f32, f32)> {
+        if !self.radial(ray) {
+            return None;
+        }
+        self.polytope.clip_ray_from_inside(ray)
+    }
+
+    /// The direction half of affinity: within the tolerance of the radial direction.
+    #[inline]
+    fn radial(&self, ray: &Ray) -> bool {
         let Some(d) = ray.dir.try_normalize() else {
             return false;
         };
@@ -161,7 +178,7 @@ impl PointArea {
             _ if f.sees_direction(d) => d,
             _ => return false,
         };
-        d.dot(radial) >= self.cos_tolerance && self.contains(ray.origin)
+        d.dot(radial) >= self.cos_tolerance
     }
 }
 

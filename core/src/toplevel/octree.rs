@@ -3,7 +3,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 use super::AreaLookup;
 use crate::geometry::Aabb;
@@ -149,17 +149,24 @@ impl Octree {
         if !self.bounds.contains_point(p) {
             return (Aabb::EMPTY, &[]);
         }
-        let mut cell = self.bounds;
+        // The same cells as `child_cell`, bit for bit: the half at or above the centre, chosen
+        // per axis with a select rather than rebuilt from the child index.
+        // `Vec3A` keeps the three axes in one SIMD register: a level is a handful of instructions.
+        let (mut lo, mut hi) = (Vec3A::from(self.bounds.min), Vec3A::from(self.bounds.max));
+        let p = Vec3A::from(p);
         let mut node = self.nodes[0];
         while node.count == INNER {
-            let mid = cell.center();
-            let child = usize::from(p.x >= mid.x)
-                | usize::from(p.y >= mid.y) << 1
-                | usize::from(p.z >= mid.z) << 2;
-            cell = child_cell(&cell, child);
-            node = self.nodes[node.first as usize + child];
+            let mid = (lo + hi) * 0.5;
+            let upper = p.cmpge(mid);
+            lo = Vec3A::select(upper, mid, lo);
+            hi = Vec3A::select(upper, hi, mid);
+            node = self.nodes[node.first as usize + upper.bitmask() as usize];
         }
         let first = node.first as usize;
+        let cell = Aabb {
+            min: lo.into(),
+            max: hi.into(),
+        };
         (cell, &self.areas[first..first + node.count as usize])
     }
 }

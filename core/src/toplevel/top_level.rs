@@ -19,10 +19,9 @@ const EXIT_OVERLAP: f32 = 1e-5;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TopLevelOptions {
     /// How every local BVH is built: the `pah` preset by default (binned SAH pricing its cuts
-    /// with the area's PAH), whose local trees cost less per ray on average than `sah`'s and the
-    /// thesis's `full` (PAH + SPFH) over the thesis's configurations; `full` is costlier on
-    /// architectural scenes. Its reinsertion runs under the preset's model (the area's PAH for
-    /// the PAH presets).
+    /// with the area's PAH), whose local trees cost less per ray on average than `sah`'s or
+    /// `full`'s (measured: benches/RESULTS.md, section Heuristic quality (SAH/PAH cost of the
+    /// presets)). Its reinsertion runs under the preset's model.
     pub local: BuildOptions,
     /// How the fallback BVH is built: `sah` (the default) or `standard`, which needs no area (the
     /// thesis's fallback was SAH + LSPH).
@@ -128,7 +127,7 @@ impl TopLevelStats {
 /// traverses each one's local BVH over the part of the segment inside the area, `[t_min, t_exit]`.
 /// A local hit is accepted only there (a closer triangle just outside the area cannot exist: the
 /// segment up to `t_exit` lies inside the area, and every triangle meeting the area is in its
-/// local BVH by the conservative separating-axis test of [`InfluenceArea::takes_triangle`]). Otherwise the
+/// local BVH by the conservative test of [`InfluenceArea::takes_triangle`]). Otherwise the
 /// fallback BVH answers the rest of the segment. Every answer equals the brute-force one.
 ///
 /// The trees `T` are binary [`Bvh`]s as built; [`TopLevel::widen`] turns every one into a
@@ -319,17 +318,15 @@ impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
             .iter()
             .filter_map(move |&a| {
                 let area = &self.areas[a as usize];
-                if !area.is_affine(ray) {
-                    return None;
+                // The local BVH answers only the part of the segment inside the area. A segment
+                // reaching back before the origin (t_min < 0) skips the area. The slack admits
+                // rays starting exactly on the light face or near plane, whose clipped entry
+                // rounds a hair past t_min, within the triangle selection's tolerance.
+                // An origin strictly inside enters at t_min itself: no slack to work out.
+                let (t0, t1) = area.affine_clip(ray)?;
+                if t0 <= ray.t_min {
+                    return Some((a, t1));
                 }
-                // The local BVH answers only the part of the segment inside the area. The origin
-                // is inside (up to the containment tolerance), so the segment's start is too
-                // unless it reaches back before the origin (t_min < 0, or -inf): then the area
-                // is skipped and the fallback answers the whole segment. The slack admits rays
-                // that start exactly on the light's rectangle or the near plane, whose clipped
-                // entry rounding puts a hair past t_min: that sliver lies within the tolerance
-                // the conservative triangle selection covers.
-                let (t0, t1) = area.polytope().clip_ray(ray)?;
                 let scale = area.polytope().scale.max(ray.origin.abs().max_element());
                 let slack = 1e-5 * scale / ray.dir.length();
                 (t0 <= ray.t_min + slack).then_some((a, t1))
@@ -339,7 +336,7 @@ impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
 
     /// The closest hit, exactly as brute force finds it.
     pub fn closest_hit(&self, ray: &Ray, tris: &[Triangle]) -> Option<Hit> {
-        self.closest_hit_with_stats(ray, tris, &mut TopLevelStats::default())
+        self.closest(ray, tris, &mut ())
     }
 
     /// [`TopLevel::closest_hit`], recording what it did in `stats`.
@@ -349,33 +346,12 @@ impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
         tris: &[Triangle],
         stats: &mut TopLevelStats,
     ) -> Option<Hit> {
-        let mut searched_to = ray.t_min;
-        for (a, t_exit) in self.affine_segments(ray) {
-            stats.tries += 1;
-            let segment = Ray {
-                t_max: t_exit.min(ray.t_max),
-                ..*ray
-            };
-            if let Some(hit) =
-                self.local[a as usize].closest_hit_with_stats(&segment, tris, &mut stats.local)
-            {
-                stats.answered_by = Some(a);
-                return Some(hit);
-            }
-            searched_to = searched_to.max(t_exit - t_exit.abs() * EXIT_OVERLAP);
-        }
-        stats.fell_back = true;
-        let rest = Ray {
-            t_min: searched_to,
-            ..*ray
-        };
-        self.fallback
-            .closest_hit_with_stats(&rest, tris, &mut stats.fallback)
+        self.closest(ray, tris, stats)
     }
 
     /// True when anything is hit on the segment, exactly as brute force says.
     pub fn any_hit(&self, ray: &Ray, tris: &[Triangle]) -> bool {
-        self.any_hit_with_stats(ray, tris, &mut TopLevelStats::default())
+        self.any(ray, tris, &mut ())
     }
 
     /// [`TopLevel::any_hit`], recording what it did in `stats`.
@@ -385,26 +361,52 @@ impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
         tris: &[Triangle],
         stats: &mut TopLevelStats,
     ) -> bool {
+        self.any(ray, tris, stats)
+    }
+
+    /// The closest-hit query, recording into `log` (`()` records nothing, and its counting
+    /// compiles away, as the trees' own does).
+    #[inline]
+    fn closest(&self, ray: &Ray, tris: &[Triangle], log: &mut impl QueryLog) -> Option<Hit> {
         let mut searched_to = ray.t_min;
         for (a, t_exit) in self.affine_segments(ray) {
-            stats.tries += 1;
             let segment = Ray {
                 t_max: t_exit.min(ray.t_max),
                 ..*ray
             };
-            if self.local[a as usize].any_hit_with_stats(&segment, tris, &mut stats.local) {
-                stats.answered_by = Some(a);
-                return true;
+            if let Some(hit) = log.local_closest(&self.local[a as usize], &segment, tris) {
+                log.answered_by(a);
+                return Some(hit);
             }
             searched_to = searched_to.max(t_exit - t_exit.abs() * EXIT_OVERLAP);
         }
-        stats.fell_back = true;
         let rest = Ray {
             t_min: searched_to,
             ..*ray
         };
-        self.fallback
-            .any_hit_with_stats(&rest, tris, &mut stats.fallback)
+        log.fallback_closest(&self.fallback, &rest, tris)
+    }
+
+    /// The any-hit query, recording into `log`.
+    #[inline]
+    fn any(&self, ray: &Ray, tris: &[Triangle], log: &mut impl QueryLog) -> bool {
+        let mut searched_to = ray.t_min;
+        for (a, t_exit) in self.affine_segments(ray) {
+            let segment = Ray {
+                t_max: t_exit.min(ray.t_max),
+                ..*ray
+            };
+            if log.local_any(&self.local[a as usize], &segment, tris) {
+                log.answered_by(a);
+                return true;
+            }
+            searched_to = searched_to.max(t_exit - t_exit.abs() * EXIT_OVERLAP);
+        }
+        let rest = Ray {
+            t_min: searched_to,
+            ..*ray
+        };
+        log.fallback_any(&self.fallback, &rest, tris)
     }
 
     /// The break-even measurement for area `area` over `rays`: its local hit rate, the local and
@@ -455,7 +457,89 @@ impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
     }
 }
 
-/// Keeps the elements whose `mask` entry is true.
+/// Where a scene query records what it did: [`TopLevelStats`], or `()` for nothing.
+trait QueryLog {
+    /// The local tree's closest hit on `ray`, one affine area tried.
+    fn local_closest<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle])
+        -> Option<Hit>;
+    /// The local tree's any hit on `ray`, one affine area tried.
+    fn local_any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle]) -> bool;
+    /// The fallback tree's closest hit on the rest of the segment.
+    fn fallback_closest<T: Traversable>(
+        &mut self,
+        t: &T,
+        ray: &Ray,
+        tris: &[Triangle],
+    ) -> Option<Hit>;
+    /// The fallback tree's any hit on the rest of the segment.
+    fn fallback_any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle]) -> bool;
+    /// Area `area`'s local tree answered.
+    fn answered_by(&mut self, area: u32);
+}
+
+impl QueryLog for () {
+    #[inline(always)]
+    fn local_closest<T: Traversable>(
+        &mut self,
+        t: &T,
+        ray: &Ray,
+        tris: &[Triangle],
+    ) -> Option<Hit> {
+        t.closest_hit(ray, tris)
+    }
+    #[inline(always)]
+    fn local_any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle]) -> bool {
+        t.any_hit(ray, tris)
+    }
+    #[inline(always)]
+    fn fallback_closest<T: Traversable>(
+        &mut self,
+        t: &T,
+        ray: &Ray,
+        tris: &[Triangle],
+    ) -> Option<Hit> {
+        t.closest_hit(ray, tris)
+    }
+    #[inline(always)]
+    fn fallback_any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle]) -> bool {
+        t.any_hit(ray, tris)
+    }
+    #[inline(always)]
+    fn answered_by(&mut self, _: u32) {}
+}
+
+impl QueryLog for TopLevelStats {
+    fn local_closest<T: Traversable>(
+        &mut self,
+        t: &T,
+        ray: &Ray,
+        tris: &[Triangle],
+    ) -> Option<Hit> {
+        self.tries += 1;
+        t.closest_hit_with_stats(ray, tris, &mut self.local)
+    }
+    fn local_any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle]) -> bool {
+        self.tries += 1;
+        t.any_hit_with_stats(ray, tris, &mut self.local)
+    }
+    fn fallback_closest<T: Traversable>(
+        &mut self,
+        t: &T,
+        ray: &Ray,
+        tris: &[Triangle],
+    ) -> Option<Hit> {
+        self.fell_back = true;
+        t.closest_hit_with_stats(ray, tris, &mut self.fallback)
+    }
+    fn fallback_any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle]) -> bool {
+        self.fell_back = true;
+        t.any_hit_with_stats(ray, tris, &mut self.fallback)
+    }
+    fn answered_by(&mut self, area: u32) {
+        self.answered_by = Some(area);
+    }
+}
+
 /// Runs `a` and `b` on rayon's threads when `threaded` (and the `rayon` feature) say so, else
 /// one after the other.
 fn side_by_side<A: Send, B: Send>(
@@ -572,7 +656,7 @@ mod tests {
         assert_eq!(wide_local_answers, local_answers);
     }
 
-    /// Found by the scene fuzz target: a segment reaching back before its origin (t_min = -inf)
+    /// A scene fuzz case: a segment reaching back before its origin (t_min = -inf)
     /// leaves the area behind the light, where the local BVH has no triangles.
     #[test]
     fn segments_reaching_back_out_of_the_area_use_the_fallback() {

@@ -112,6 +112,11 @@ pub struct RenderReport {
     pub light_buffers_dropped: usize,
     /// Shadow segments of the pilot frame (0 when there was no buffer to decide on).
     pub pilot_shadow_rays: usize,
+    /// Influence areas of the `thesis` structure (0 for the others): frustums of point and
+    /// spot lights plus oriented boxes of quad lights and emissive clusters.
+    pub influence_areas: usize,
+    /// Triangles over every local BVH of the `thesis` structure (one in two areas counts twice).
+    pub influence_area_triangles: u64,
     /// Image width.
     pub width: u32,
     /// Image height.
@@ -124,7 +129,7 @@ pub struct RenderReport {
     pub seed: u64,
     /// Threads that rendered.
     pub threads: usize,
-    /// `global` or `lights`.
+    /// `global`, `lights` or `thesis`.
     pub structure: &'static str,
     /// Wall-clock milliseconds of the structure's build (global BVH, light buffers and the pilot
     /// frame that chose among them).
@@ -139,8 +144,8 @@ pub struct RenderReport {
     pub bounce_rays: u64,
     /// Shadow segments that something blocked.
     pub shadow_occluded: u64,
-    /// Inner nodes the shadow segments visited, 4-wide nodes for both structures (a light
-    /// buffer's cell lookup counts as one).
+    /// Inner nodes the shadow segments visited, 4-wide nodes for every structure (a light
+    /// buffer's cell lookup, and the `thesis` octree's, counts as one).
     pub shadow_node_tests: u64,
     /// Ray/triangle tests of the shadow segments.
     pub shadow_triangle_tests: u64,
@@ -237,6 +242,7 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         write_records(dir, &frame.recorded)?;
     }
     let c = frame.counters;
+    let thesis = structure.thesis().map(|t| t.summary()).unwrap_or_default();
     Ok(RenderReport {
         scene: scene.name.clone(),
         triangles: scene.len(),
@@ -244,6 +250,8 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         light_buffers: structure.light_buffers().len(),
         light_buffers_dropped: pilot.dropped,
         pilot_shadow_rays: pilot.shadow_rays,
+        influence_areas: thesis.point_areas + thesis.plane_areas,
+        influence_area_triangles: thesis.local_triangles,
         width: args.width,
         height: args.height,
         spp: args.spp,
@@ -306,6 +314,10 @@ fn print_summary(r: &RenderReport, out: &mut impl Write) -> std::io::Result<()> 
         r.structure,
         r.build_ms,
         match (r.light_buffers, r.light_buffers_dropped) {
+            (0, 0) if r.influence_areas > 0 => format!(
+                " ({} influence areas, {} triangles in their local BVHs)",
+                r.influence_areas, r.influence_area_triangles
+            ),
             (0, 0) => String::new(),
             (kept, 0) => format!(" ({kept} light buffers)"),
             (kept, dropped) => format!(

@@ -25,16 +25,17 @@ pub const CLUSTER_EXTENT: f32 = 0.25;
 /// bounds the clustering's quadratic search.
 const MAX_CLUSTERS: usize = 4096;
 
-/// A group of lights that share one buffer.
-struct Group {
-    lights: Vec<u32>,
-    points: Vec<Vec3>,
+/// A group of lights that share one buffer (or, for `thesis`, one set of influence areas).
+pub(super) struct Group {
+    pub(super) lights: Vec<u32>,
+    /// The emissive triangles' vertices, three a triangle.
+    pub(super) points: Vec<Vec3>,
     bounds: Aabb,
     /// The group's emissive material (none for a light from the lights file).
     material: Option<Vec3>,
-    power: f32,
+    pub(super) power: f32,
     /// The light from the lights file, whose own source (cone, front) is kept.
-    single: Option<Light>,
+    pub(super) single: Option<Light>,
 }
 
 /// The light buffers for `lights` over `triangles`, built on the current rayon pool (every face
@@ -76,7 +77,7 @@ pub(super) fn light_buffers(
 }
 
 /// Every light from the lights file alone; emissive triangles clustered per material.
-fn group(triangles: &[Triangle], lights: &[Light]) -> Vec<Group> {
+pub(super) fn group(triangles: &[Triangle], lights: &[Light]) -> Vec<Group> {
     let scene = triangles
         .iter()
         .fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));

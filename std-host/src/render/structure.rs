@@ -2,8 +2,9 @@
 //!
 //! Camera and bounce rays always go through the global BVH. Shadow rays go through the
 //! structure: with `global` the same BVH, with `lights` the light buffer of the ray's light when
-//! it has one, and the global BVH for every segment the buffer does not answer. Both answer every
-//! query exactly as the global BVH does, so the images are byte-identical.
+//! it has one, and the global BVH for every segment the buffer does not answer, with `thesis`
+//! the thesis's influence areas, octree and fallback ([`super::thesis`]). All answer every query
+//! exactly as the global BVH does, so the images are byte-identical.
 
 use std::time::Instant;
 
@@ -14,6 +15,7 @@ use rdbvh_core::heuristics::Sah;
 use rdbvh_core::light_buffer::LightBuffer;
 
 use super::light_structure::light_buffers;
+use super::thesis::ThesisStructure;
 use super::{Light, RenderError};
 use crate::parallel;
 
@@ -27,6 +29,11 @@ pub enum StructureKind {
     /// automatically and kept where a pilot frame's shadow rays show that it pays
     /// ([`super::pilot`]), with the global BVH for what a buffer does not answer.
     Lights,
+    /// The thesis's structure with influence areas made from the lights: six frustums around
+    /// a point light, one along a spot, an oriented box in front of a quad light or an emissive
+    /// cluster; a local BVH per area (PAH), an octree over the areas, and the global BVH as the
+    /// fallback ([`super::thesis`]).
+    Thesis,
 }
 
 impl StructureKind {
@@ -35,6 +42,7 @@ impl StructureKind {
         match self {
             StructureKind::Global => "global",
             StructureKind::Lights => "lights",
+            StructureKind::Thesis => "thesis",
         }
     }
 }
@@ -47,6 +55,9 @@ pub struct Structure {
     buffers: Vec<LightBuffer>,
     /// Per light (index into the renderer's lights), its buffer's index, or `NO_BUFFER`.
     buffer_of: Vec<u32>,
+    /// The `thesis` structure, which owns the global BVH as its fallback (`global` is then
+    /// empty: no second copy).
+    thesis: Option<ThesisStructure>,
     build_ms: f64,
 }
 
@@ -64,16 +75,27 @@ impl Structure {
         let start = Instant::now();
         let mut bvh = parallel::build(&Builder::sah(), triangles)?;
         reinsert(&mut bvh, &Sah, &ReinsertConfig::default());
-        let global = WideBvh::from_binary(&bvh, triangles);
+        let mut global = WideBvh::from_binary(&bvh, triangles);
         let (buffers, buffer_of) = match kind {
-            StructureKind::Global => (Vec::new(), vec![NO_BUFFER; lights.len()]),
+            StructureKind::Global | StructureKind::Thesis => {
+                (Vec::new(), vec![NO_BUFFER; lights.len()])
+            }
             StructureKind::Lights => light_buffers(triangles, lights)?,
+        };
+        let thesis = match kind {
+            StructureKind::Thesis => Some(ThesisStructure::build(
+                triangles,
+                lights,
+                std::mem::take(&mut global),
+            )?),
+            _ => None,
         };
         Ok(Self {
             kind,
             global,
             buffers,
             buffer_of,
+            thesis,
             build_ms: start.elapsed().as_secs_f64() * 1e3,
         })
     }
@@ -94,8 +116,17 @@ impl Structure {
     }
 
     /// The global BVH.
+    #[inline]
     pub fn global(&self) -> &WideBvh {
-        &self.global
+        match &self.thesis {
+            Some(t) => t.fallback(),
+            None => &self.global,
+        }
+    }
+
+    /// The `thesis` structure, when that is the kind built.
+    pub fn thesis(&self) -> Option<&ThesisStructure> {
+        self.thesis.as_ref()
     }
 
     /// The index of `light`'s buffer, if it has one.
@@ -132,31 +163,37 @@ impl Structure {
     /// The closest hit of a camera or bounce ray: always the global BVH.
     #[inline]
     pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
-        self.global.closest_hit(ray)
+        self.global().closest_hit(ray)
     }
 
     /// Whether anything blocks the shadow segment `ray` toward light `light`.
     #[inline]
     pub fn occluded(&self, light: usize, ray: &Ray) -> bool {
+        if let Some(t) = &self.thesis {
+            return t.occluded(ray);
+        }
         let buffer = self.buffer_of[light];
         if buffer != NO_BUFFER {
             if let Some(answer) = self.buffers[buffer as usize].occluded(ray) {
                 return answer;
             }
         }
-        self.global.any_hit(ray)
+        self.global().any_hit(ray)
     }
 
     /// [`Structure::occluded`], counting node and triangle tests in `stats` (a light buffer's
-    /// cell lookup counts as one inner node).
+    /// cell lookup, and the `thesis` octree's, counts as one inner node).
     #[inline]
     pub fn occluded_counted(&self, light: usize, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        if let Some(t) = &self.thesis {
+            return t.occluded_counted(ray, stats);
+        }
         let buffer = self.buffer_of[light];
         if buffer != NO_BUFFER {
             if let Some(answer) = self.buffers[buffer as usize].occluded_with_stats(ray, stats) {
                 return answer;
             }
         }
-        self.global.any_hit_with_stats(ray, stats)
+        self.global().any_hit_with_stats(ray, stats)
     }
 }

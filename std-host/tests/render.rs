@@ -116,6 +116,7 @@ fn json_has_the_contract_keys() {
         "threads",
         "light_buffers",
         "light_buffers_dropped",
+        "light_buffers_skipped",
         "pilot_shadow_rays",
         "influence_areas",
         "influence_area_triangles",

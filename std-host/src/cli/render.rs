@@ -14,9 +14,9 @@ use super::answers::{write_answers, Answers};
 use super::rays::write_rays;
 use super::{load_scene, CliError};
 use crate::render::{
-    emissive_lights, encode_png, mean_luminance, pilot_size, prune_by_pilot, read_lights,
+    build_lights, emissive_lights, encode_png, mean_luminance, pilot_size, read_lights,
     render_frame, replay_shadow_rays, to_srgb8, Camera, FrameSettings, Integrator, LightSet,
-    RecordedRays, RenderError, Structure, StructureKind, DEFAULT_FOV_DEG,
+    PilotReport, RecordedRays, RenderError, Structure, StructureKind, DEFAULT_FOV_DEG,
 };
 
 /// Arguments of `rdbvh render`.
@@ -107,9 +107,12 @@ pub struct RenderReport {
     pub lights: usize,
     /// Light buffers in use (0 for `global`): those built that the pilot frame kept.
     pub light_buffers: usize,
-    /// Light buffers built and dropped because the pilot frame's shadow rays showed that they
-    /// do not pay (their lights use the global BVH).
+    /// Light buffers dropped because the pilot frame's shadow rays showed that they do not pay
+    /// (their lights use the global BVH), whether built first or not.
     pub light_buffers_dropped: usize,
+    /// Of those dropped, the ones never built: the light is too wide next to its pilot shadow
+    /// segments' lengths for a buffer to pay (`render::pilot::MAX_EXTENT_RATIO`).
+    pub light_buffers_skipped: usize,
     /// Shadow segments of the pilot frame (0 when there was no buffer to decide on).
     pub pilot_shadow_rays: usize,
     /// Influence areas of the `thesis` structure (0 for the others): frustums of point and
@@ -206,17 +209,21 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         )
     };
     let camera = camera_of((args.width, args.height))?;
-    let mut structure = Structure::build(args.structure, &scene.triangles, lights.lights())?;
     let size = pilot_size(args.width, args.height);
-    let pilot = prune_by_pilot(
-        &mut structure,
-        &scene,
-        &lights,
-        args.max_bounces,
-        &camera_of(size)?,
-        size,
-        args.seed,
-    )?;
+    let (structure, pilot) = match args.structure {
+        StructureKind::Lights => build_lights(
+            &scene,
+            &lights,
+            args.max_bounces,
+            &camera_of(size)?,
+            size,
+            args.seed,
+        )?,
+        kind => (
+            Structure::build(kind, &scene.triangles, lights.lights())?,
+            PilotReport::default(),
+        ),
+    };
     let integrator = Integrator::new(&scene, &lights, &structure, args.max_bounces)?;
     let settings = FrameSettings {
         width: args.width,
@@ -249,6 +256,7 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         lights: lights.lights().len(),
         light_buffers: structure.light_buffers().len(),
         light_buffers_dropped: pilot.dropped,
+        light_buffers_skipped: pilot.skipped,
         pilot_shadow_rays: pilot.shadow_rays,
         influence_areas: thesis.point_areas + thesis.plane_areas,
         influence_area_triangles: thesis.local_triangles,
@@ -321,8 +329,9 @@ fn print_summary(r: &RenderReport, out: &mut impl Write) -> std::io::Result<()> 
             (0, 0) => String::new(),
             (kept, 0) => format!(" ({kept} light buffers)"),
             (kept, dropped) => format!(
-                " ({kept} light buffers; {dropped} dropped by the pilot frame's {} shadow rays)",
-                r.pilot_shadow_rays
+                " ({kept} light buffers; {dropped} dropped by the pilot frame's {} shadow rays, \
+                 {} of them before building)",
+                r.pilot_shadow_rays, r.light_buffers_skipped
             ),
         }
     )?;

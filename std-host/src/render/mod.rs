@@ -45,7 +45,7 @@ pub use integrator::{Integrator, ShadowRay, SHADOW_END};
 pub use light::{emissive_lights, luminance, Light, LightSample, LightSet};
 pub use light_structure::{CLUSTER_EXTENT, MAX_LIGHT_BUFFERS};
 pub use lights_file::{parse_lights, read_lights};
-pub use pilot::{pilot_size, prune_by_pilot, PilotReport, KEEP_RATIO, PILOT_DIVISOR};
+pub use pilot::{build_lights, pilot_size, prune_by_pilot, PilotReport, KEEP_RATIO, PILOT_DIVISOR};
 pub use replay::replay_shadow_rays;
 pub use structure::{Structure, StructureKind};
 pub use thesis::{ThesisStructure, ThesisSummary};

@@ -155,6 +155,19 @@ impl Structure {
         }
     }
 
+    /// Makes this structure `lights` with `buffers`, `buffer_of` naming each light's buffer
+    /// (or `NO_BUFFER`), for a host that chose which buffers to build ([`super::pilot`]).
+    pub(super) fn install_buffers(&mut self, buffers: Vec<LightBuffer>, buffer_of: Vec<u32>) {
+        self.kind = StructureKind::Lights;
+        self.buffers = buffers;
+        self.buffer_of = buffer_of;
+    }
+
+    /// Sets the build time to what the whole build took, pilot frame included.
+    pub(super) fn set_build_ms(&mut self, ms: f64) {
+        self.build_ms = ms;
+    }
+
     /// Adds work done after the build that belongs to it (the pilot frame) to its time.
     pub(super) fn add_build_ms(&mut self, ms: f64) {
         self.build_ms += ms;

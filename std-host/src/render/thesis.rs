@@ -38,7 +38,7 @@ use rdbvh_core::toplevel::{
 };
 use rdbvh_core::Vec3;
 
-use super::light_structure::{group, Group};
+use super::light_structure::{light_groups, Group};
 use super::{Light, RenderError};
 
 /// How far before an area's exit the fallback search starts, relative to the exit distance (as
@@ -82,9 +82,7 @@ impl ThesisStructure {
         let scene = triangles
             .iter()
             .fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
-        let mut groups = group(triangles, lights);
-        groups.sort_by(|a, b| b.power.total_cmp(&a.power));
-        groups.truncate(super::MAX_LIGHT_BUFFERS);
+        let groups = light_groups(triangles, lights);
         let areas: Vec<InfluenceArea> = groups.iter().flat_map(|g| areas_of(g, scene)).collect();
         let preset = TopLevelOptions::default().preset;
         let options = TopLevelOptions::default().local;

@@ -9,6 +9,11 @@
 //! only if it needs at most [`KEEP_RATIO`] of the global BVH's tests. Counts, not clocks, decide,
 //! so the choice is the same on every run; the answers are the global BVH's either way, so the
 //! image does not change.
+//!
+//! [`build_lights`] traces the pilot through the global BVH before building any buffer, and
+//! builds none for a light too wide next to its pilot segments ([`MAX_EXTENT_RATIO`]): such a
+//! buffer never paid, and costs the most to build. [`prune_by_pilot`] decides for a structure
+//! whose buffers are all built already.
 
 use std::time::Instant;
 
@@ -66,7 +71,6 @@ fn decide(
     let pilot = render_frame(integrator, camera, &settings);
     let n = structure.light_buffers().len();
     let (mut through_buffer, mut through_global) = (vec![0u64; n], vec![0u64; n]);
-    let tests = |s: &TraversalStats| u64::from(s.inner_nodes) + u64::from(s.triangles);
     for s in &pilot.shadow_rays {
         let Some(b) = structure.buffer_of(s.light as usize) else {
             continue;
@@ -80,18 +84,14 @@ fn decide(
         through_buffer[b] += tests(&via_buffer);
         through_global[b] += tests(&via_global);
     }
-    // A buffer no pilot ray used has shown no saving: its light is rarely chosen, or unseen.
-    let pays = |b: usize| {
-        through_global[b] > 0
-            && through_buffer[b] as f64 <= f64::from(KEEP_RATIO) * through_global[b] as f64
-    };
-    ((0..n).map(pays).collect(), pilot.shadow_rays.len())
+    let keep = (0..n).map(|b| pays(through_buffer[b], through_global[b]));
+    (keep.collect(), pilot.shadow_rays.len())
 }
 
 /// The `lights` structure built with the pilot frame deciding first: the global BVH, the pilot
 /// frame of `camera` (made at [`pilot_size`], `size`) traced through it, then a buffer built only
 /// for the light groups whose pilot segments leave it a chance to pay
-/// ([`worth_building`]), and of those kept only the ones that need at most [`KEEP_RATIO`] of the
+/// ([`MAX_EXTENT_RATIO`]), and of those kept only the ones that need at most [`KEEP_RATIO`] of the
 /// global BVH's tests on the same segments. The pilot's segments do not depend on the
 /// structure (every structure answers alike), so one pilot serves both decisions.
 pub fn build_lights(
@@ -188,7 +188,8 @@ fn tests(s: &TraversalStats) -> u64 {
     u64::from(s.inner_nodes) + u64::from(s.triangles)
 }
 
-/// Whether `through_buffer` tests pay against `through_global` on the same segments.
+/// Whether `through_buffer` tests pay against `through_global` on the same segments. A buffer
+/// no pilot segment used has shown no saving: its light is rarely chosen, or unseen.
 fn pays(through_buffer: u64, through_global: u64) -> bool {
     through_global > 0 && through_buffer as f64 <= f64::from(KEEP_RATIO) * through_global as f64
 }

@@ -3,7 +3,7 @@
 //! Camera and bounce rays always go through the global BVH. Shadow rays go through the
 //! structure: with `global` the same BVH, with `lights` the light buffer of the ray's light when
 //! it has one, and the global BVH for every segment the buffer does not answer, with `thesis`
-//! the thesis's influence areas, octree and fallback ([`super::thesis`]). All answer every query
+//! the thesis's influence areas, octree and fallback ([`super::ThesisStructure`]). All answer every query
 //! exactly as the global BVH does, so the images are byte-identical.
 
 use std::time::Instant;
@@ -32,7 +32,7 @@ pub enum StructureKind {
     /// The thesis's structure with influence areas made from the lights: six frustums around
     /// a point light, one along a spot, an oriented box in front of a quad light or an emissive
     /// cluster; a local BVH per area (PAH), an octree over the areas, and the global BVH as the
-    /// fallback ([`super::thesis`]).
+    /// fallback ([`super::ThesisStructure`]).
     Thesis,
 }
 

@@ -57,10 +57,12 @@ fn images_depend_on_the_seed_alone_whatever_the_threads_and_structure() {
     let one = render(&scene, &dir.join("one.png"), &["--threads", "1"]);
     let two = render(&scene, &dir.join("two.png"), &["--threads", "2"]);
     let lights = render(&scene, &dir.join("lights.png"), &["--structure", "lights"]);
+    let thesis = render(&scene, &dir.join("thesis.png"), &["--structure", "thesis"]);
     let other = render(&scene, &dir.join("seed.png"), &["--seed", "2"]);
     let png = |n: &str| std::fs::read(dir.join(n)).unwrap();
     assert_eq!(png("one.png"), png("two.png"));
     assert_eq!(png("one.png"), png("lights.png"));
+    assert_eq!(png("one.png"), png("thesis.png"));
     assert_ne!(png("one.png"), png("seed.png"));
     for key in [
         "camera_rays",
@@ -71,7 +73,14 @@ fn images_depend_on_the_seed_alone_whatever_the_threads_and_structure() {
     ] {
         assert_eq!(one[key], two[key], "{key}");
         assert_eq!(one[key], lights[key], "{key}");
+        assert_eq!(one[key], thesis[key], "{key}");
     }
+    assert_eq!(thesis["structure"], "thesis");
+    assert_eq!(
+        thesis["influence_areas"], 2,
+        "the room's emissive quad: a box on each side"
+    );
+    assert_eq!(one["influence_areas"], 0);
     assert_ne!(one["mean_luminance"], other["mean_luminance"]);
     assert_eq!(one["structure"], "global");
     assert_eq!(lights["structure"], "lights");
@@ -107,7 +116,10 @@ fn json_has_the_contract_keys() {
         "threads",
         "light_buffers",
         "light_buffers_dropped",
+        "light_buffers_skipped",
         "pilot_shadow_rays",
+        "influence_areas",
+        "influence_area_triangles",
     ] {
         assert!(json.get(key).is_some(), "{key} missing: {json}");
     }
@@ -291,6 +303,31 @@ fn cornell_box_with_every_light_kind_is_identical_across_structures() {
     );
     assert_eq!(global["shadow_occluded"], buffered["shadow_occluded"]);
     assert!(global["mean_luminance"].as_f64().unwrap() > 0.01);
+    // The thesis's structure: the same image, and its recorded shadow answers are brute force's.
+    let rays = dir.join("rays");
+    let mut args = l.to_vec();
+    let limit = "3000";
+    args.extend(["--structure", "thesis", "--record-rays"]);
+    args.extend([rays.to_str().unwrap(), "--record-limit", limit]);
+    let thesis = render(&scene, &dir.join("t.png"), &args);
+    assert_eq!(
+        std::fs::read(dir.join("g.png")).unwrap(),
+        std::fs::read(dir.join("t.png")).unwrap()
+    );
+    assert_eq!(global["shadow_occluded"], thesis["shadow_occluded"]);
+    // Six faces of the point light (those that see the box), one spot frustum, one quad box,
+    // and boxes on the sides of the emissive light that face the box.
+    assert!(thesis["influence_areas"].as_u64().unwrap() >= 5, "{thesis}");
+    let triangles = Scene::open(obj.to_str().unwrap()).unwrap().triangles;
+    let recorded = read_rays(&rays.join("shadow_rays.csv")).unwrap();
+    let hits = std::fs::read_to_string(rays.join("shadow_hits.csv")).unwrap();
+    let rows: Vec<&str> = hits.lines().skip(1).collect();
+    assert_eq!(recorded.len(), rows.len());
+    assert_eq!(recorded.len(), 3000);
+    for (ray, row) in recorded.iter().zip(&rows) {
+        let blocked = row.split(',').nth(1) == Some("1");
+        assert_eq!(blocked, brute_force::any_hit(ray, &triangles), "{row}");
+    }
 }
 
 /// The pilot frame drops the Cornell box's buffer: its quad light is large next to the box, so

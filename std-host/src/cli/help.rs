@@ -128,14 +128,26 @@ pub fn render() -> String {
          what segments toward the light through that cell can hit; emissive triangles are\n\
          clustered per material, at most 32 buffers, for the most powerful lights), with the\n\
          global BVH for segments a buffer does not take. A pilot frame (1/8 of the resolution,\n\
-         1 sample) then keeps a buffer only where its shadow segments need at most 0.7 of the\n\
-         global BVH's node + triangle tests; build_ms includes it. Both structures answer exactly\n\
+         1 sample, traced through the global BVH first) decides: a light wider than half its\n\
+         pilot segments' median length gets no buffer built, and a buffer built is kept\n\
+         only where those segments need at most 0.7 of the global BVH's node + triangle tests\n\
+         through it; build_ms includes the pilot. thesis, the thesis's own\n\
+         structure with influence areas made from the lights: six 90-degree frustums around a\n\
+         point light (one per cube face, apex at the light, to the scene's far end), one frustum\n\
+         along a spot of at most 120 degrees (six for a wider one), an oriented box in front of\n\
+         a quad light or an emissive cluster (both sides); a local BVH per area (pah preset),\n\
+         an octree over the areas and the global BVH as the fallback. A segment whose origin is\n\
+         inside an area and which runs toward its light (within 1 degree of the radial direction\n\
+         for a frustum; ending inside the box for a box) is answered by that area's local BVH up\n\
+         to where it leaves the area, the rest by the fallback. Every structure answers exactly\n\
          as the global BVH does: the images are byte-identical.\n\
          shadow_ms is the best of --shadow-replays single-thread replays of the frame's shadow\n\
          segments (its first 2097152 when it has more) through the structure alone, without\n\
          counters; the replay's answers must equal the frame's.\n\
          --json prints one object as the last line, with the keys scene, triangles, lights,\n\
-         light_buffers, light_buffers_dropped, pilot_shadow_rays, width, height, spp, max_bounces, seed, threads, structure, build_ms,\n\
+         light_buffers, light_buffers_dropped, light_buffers_skipped, pilot_shadow_rays,\n\
+         influence_areas,\n\
+         influence_area_triangles, width, height, spp, max_bounces, seed, threads, structure, build_ms,\n\
          render_ms, camera_rays, shadow_rays, bounce_rays, shadow_occluded, shadow_node_tests,\n\
          shadow_triangle_tests, shadow_replay_rays, shadow_ms, mean_luminance and out.\n\
          --record-rays DIR writes the first --record-limit rays of each kind (in tile order, then\n\

@@ -15,9 +15,9 @@ use super::error::CliError;
 use super::inputs::load_scene;
 use super::rays::write_rays;
 use crate::render::{
-    emissive_lights, encode_png, mean_luminance, pilot_size, prune_by_pilot, read_lights,
+    build_lights, emissive_lights, encode_png, mean_luminance, pilot_size, read_lights,
     render_frame, replay_shadow_rays, to_srgb8, Camera, FrameSettings, Integrator, LightSet,
-    RecordedRays, RenderError, Structure, StructureKind, DEFAULT_FOV_DEG,
+    PilotReport, RecordedRays, RenderError, Structure, StructureKind, DEFAULT_FOV_DEG,
 };
 
 /// Arguments of `rdbvh render`.
@@ -108,11 +108,19 @@ pub struct RenderReport {
     pub lights: usize,
     /// Light buffers in use (0 for `global`): those built that the pilot frame kept.
     pub light_buffers: usize,
-    /// Light buffers built and dropped because the pilot frame's shadow rays showed that they
-    /// do not pay (their lights use the global BVH).
+    /// Light buffers dropped because the pilot frame's shadow rays showed that they do not pay
+    /// (their lights use the global BVH), whether built first or not.
     pub light_buffers_dropped: usize,
+    /// Of those dropped, the ones never built: the light is too wide next to its pilot shadow
+    /// segments' lengths for a buffer to pay (`render::pilot::MAX_EXTENT_RATIO`).
+    pub light_buffers_skipped: usize,
     /// Shadow segments of the pilot frame (0 when there was no buffer to decide on).
     pub pilot_shadow_rays: usize,
+    /// Influence areas of the `thesis` structure (0 for the others): frustums of point and
+    /// spot lights plus oriented boxes of quad lights and emissive clusters.
+    pub influence_areas: usize,
+    /// Triangles over every local BVH of the `thesis` structure (one in two areas counts twice).
+    pub influence_area_triangles: u64,
     /// Image width.
     pub width: u32,
     /// Image height.
@@ -125,7 +133,7 @@ pub struct RenderReport {
     pub seed: u64,
     /// Threads that rendered.
     pub threads: usize,
-    /// `global` or `lights`.
+    /// `global`, `lights` or `thesis`.
     pub structure: &'static str,
     /// Wall-clock milliseconds of the structure's build (global BVH, light buffers and the pilot
     /// frame that chose among them).
@@ -140,8 +148,8 @@ pub struct RenderReport {
     pub bounce_rays: u64,
     /// Shadow segments that something blocked.
     pub shadow_occluded: u64,
-    /// Inner nodes the shadow segments visited, 4-wide nodes for both structures (a light
-    /// buffer's cell lookup counts as one).
+    /// Inner nodes the shadow segments visited, 4-wide nodes for every structure (a light
+    /// buffer's cell lookup, and the `thesis` octree's, counts as one).
     pub shadow_node_tests: u64,
     /// Ray/triangle tests of the shadow segments.
     pub shadow_triangle_tests: u64,
@@ -202,17 +210,21 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         )
     };
     let camera = camera_of((args.width, args.height))?;
-    let mut structure = Structure::build(args.structure, &scene.triangles, lights.lights())?;
     let size = pilot_size(args.width, args.height);
-    let pilot = prune_by_pilot(
-        &mut structure,
-        &scene,
-        &lights,
-        args.max_bounces,
-        &camera_of(size)?,
-        size,
-        args.seed,
-    )?;
+    let (structure, pilot) = match args.structure {
+        StructureKind::Lights => build_lights(
+            &scene,
+            &lights,
+            args.max_bounces,
+            &camera_of(size)?,
+            size,
+            args.seed,
+        )?,
+        kind => (
+            Structure::build(kind, &scene.triangles, lights.lights())?,
+            PilotReport::default(),
+        ),
+    };
     let integrator = Integrator::new(&scene, &lights, &structure, args.max_bounces)?;
     let settings = FrameSettings {
         width: args.width,
@@ -238,13 +250,17 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         write_records(dir, &frame.recorded)?;
     }
     let c = frame.counters;
+    let thesis = structure.thesis().map(|t| t.summary()).unwrap_or_default();
     Ok(RenderReport {
         scene: scene.name.clone(),
         triangles: scene.len(),
         lights: lights.lights().len(),
         light_buffers: structure.light_buffers().len(),
         light_buffers_dropped: pilot.dropped,
+        light_buffers_skipped: pilot.skipped,
         pilot_shadow_rays: pilot.shadow_rays,
+        influence_areas: thesis.point_areas + thesis.plane_areas,
+        influence_area_triangles: thesis.local_triangles,
         width: args.width,
         height: args.height,
         spp: args.spp,
@@ -307,11 +323,16 @@ fn print_summary(r: &RenderReport, out: &mut impl Write) -> std::io::Result<()> 
         r.structure,
         r.build_ms,
         match (r.light_buffers, r.light_buffers_dropped) {
+            (0, 0) if r.influence_areas > 0 => format!(
+                " ({} influence areas, {} triangles in their local BVHs)",
+                r.influence_areas, r.influence_area_triangles
+            ),
             (0, 0) => String::new(),
             (kept, 0) => format!(" ({kept} light buffers)"),
             (kept, dropped) => format!(
-                " ({kept} light buffers; {dropped} dropped by the pilot frame's {} shadow rays)",
-                r.pilot_shadow_rays
+                " ({kept} light buffers; {dropped} dropped by the pilot frame's {} shadow rays, \
+                 {} of them before building)",
+                r.pilot_shadow_rays, r.light_buffers_skipped
             ),
         }
     )?;

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use rdbvh_core::builder::PresetError;
 use rdbvh_core::light_buffer::LightSourceError;
+use rdbvh_core::toplevel::TopLevelError;
 use rdbvh_core::BuildError;
 
 /// Why a render could not start or finish.
@@ -54,6 +55,8 @@ pub enum RenderError {
     Build(BuildError),
     /// A light could not be made into a light buffer's source.
     LightSource(LightSourceError),
+    /// A local BVH of the `thesis` structure could not be built.
+    Thesis(TopLevelError),
     /// The replay of the frame's shadow rays disagreed with the frame: a bug, reported loudly.
     Replay(String),
     /// The image could not be encoded.
@@ -87,6 +90,7 @@ impl fmt::Display for RenderError {
             RenderError::Camera(why) => write!(f, "camera: {why}"),
             RenderError::Build(e) => write!(f, "BVH build failed: {e}"),
             RenderError::LightSource(e) => write!(f, "light buffer: {e}"),
+            RenderError::Thesis(e) => write!(f, "thesis structure: {e}"),
             RenderError::Replay(what) => write!(f, "shadow ray replay disagrees: {what}"),
             RenderError::Encode(why) => write!(f, "cannot encode the PNG: {why}"),
         }

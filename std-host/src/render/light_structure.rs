@@ -25,16 +25,17 @@ pub const CLUSTER_EXTENT: f32 = 0.25;
 /// bounds the clustering's quadratic search.
 const MAX_CLUSTERS: usize = 4096;
 
-/// A group of lights that share one buffer.
-struct Group {
-    lights: Vec<u32>,
-    points: Vec<Vec3>,
+/// A group of lights that share one buffer (or, for `thesis`, one set of influence areas).
+pub(super) struct Group {
+    pub(super) lights: Vec<u32>,
+    /// The emissive triangles' vertices, three a triangle.
+    pub(super) points: Vec<Vec3>,
     bounds: Aabb,
     /// The group's emissive material (none for a light from the lights file).
     material: Option<Vec3>,
-    power: f32,
+    pub(super) power: f32,
     /// The light from the lights file, whose own source (cone, front) is kept.
-    single: Option<Light>,
+    pub(super) single: Option<Light>,
 }
 
 /// The light buffers for `lights` over `triangles`, built on the current rayon pool (every face
@@ -43,9 +44,26 @@ pub(super) fn light_buffers(
     triangles: &[Triangle],
     lights: &[Light],
 ) -> Result<(Vec<LightBuffer>, Vec<u32>), RenderError> {
+    let groups = light_groups(triangles, lights);
+    build_buffers(triangles, &groups.iter().collect::<Vec<_>>(), lights.len())
+}
+
+/// The groups that may get a buffer: every light from the lights file, emissive triangles
+/// clustered, the [`MAX_LIGHT_BUFFERS`] most powerful.
+pub(super) fn light_groups(triangles: &[Triangle], lights: &[Light]) -> Vec<Group> {
     let mut groups = group(triangles, lights);
     groups.sort_by(|a, b| b.power.total_cmp(&a.power));
     groups.truncate(MAX_LIGHT_BUFFERS);
+    groups
+}
+
+/// The buffers of `groups`, built on the current rayon pool (every face of every buffer in
+/// parallel), and per light (of `light_count`) the index of its buffer or `NO_BUFFER`.
+pub(super) fn build_buffers(
+    triangles: &[Triangle],
+    groups: &[&Group],
+    light_count: usize,
+) -> Result<(Vec<LightBuffer>, Vec<u32>), RenderError> {
     let options = LightBufferOptions::default();
     let builders = groups
         .iter()
@@ -66,13 +84,27 @@ pub(super) fn light_buffers(
         .into_iter()
         .map(|b| b.finish(faces.by_ref().take(LightBufferBuilder::FACES)))
         .collect::<Result<Vec<_>, _>>()?;
-    let mut buffer_of = vec![NO_BUFFER; lights.len()];
+    let mut buffer_of = vec![NO_BUFFER; light_count];
     for (b, g) in groups.iter().enumerate() {
         for &l in &g.lights {
             buffer_of[l as usize] = b as u32;
         }
     }
     Ok((buffers, buffer_of))
+}
+
+impl Group {
+    /// The light's width: the diagonal of its emissive triangles' box, a quad's longer
+    /// diagonal, 0 for a point or spot light.
+    pub(super) fn extent(&self) -> f32 {
+        match self.single {
+            Some(Light::Quad { edge1, edge2, .. }) => {
+                (edge1 + edge2).length().max((edge1 - edge2).length())
+            }
+            Some(_) => 0.0,
+            None => (self.bounds.max - self.bounds.min).length(),
+        }
+    }
 }
 
 /// Every light from the lights file alone; emissive triangles clustered per material.

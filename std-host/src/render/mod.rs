@@ -14,8 +14,9 @@
 //! - **Determinism.** Every random number is a hash of (seed, pixel, sample, dimension)
 //!   ([`sampler`]): the image depends on the seed alone, not on threads or tiles.
 //! - **Structures.** Camera and bounce rays go through the global BVH; shadow segments through
-//!   the [`Structure`] chosen (`global`, or `lights`: a light buffer per light where a pilot
-//!   frame shows it pays, [`pilot`]). Both answer
+//!   the [`Structure`] chosen (`global`; `lights`: a light buffer per light where a pilot
+//!   frame shows it pays, [`pilot`]; or `thesis`: the thesis's influence areas, octree and
+//!   fallback, [`ThesisStructure`]). All answer
 //!   exactly as the global BVH does, so their images are byte-identical.
 //! - **Measures.** The frame counts its rays and the shadow segments' node and triangle tests;
 //!   [`replay_shadow_rays`] times the frame's shadow segments on one thread.
@@ -32,6 +33,7 @@ pub mod pilot;
 mod replay;
 pub mod sampler;
 mod structure;
+mod thesis;
 
 pub use self::image::{encode_png, mean_luminance, srgb, to_srgb8};
 pub use camera::{Camera, DEFAULT_FOV_DEG};
@@ -43,6 +45,7 @@ pub use integrator::{Integrator, ShadowRay, SHADOW_END};
 pub use light::{emissive_lights, luminance, Light, LightSample, LightSet};
 pub use light_structure::{CLUSTER_EXTENT, MAX_LIGHT_BUFFERS};
 pub use lights_file::{parse_lights, read_lights};
-pub use pilot::{pilot_size, prune_by_pilot, PilotReport, KEEP_RATIO, PILOT_DIVISOR};
+pub use pilot::{build_lights, pilot_size, prune_by_pilot, PilotReport, KEEP_RATIO, PILOT_DIVISOR};
 pub use replay::replay_shadow_rays;
 pub use structure::{Structure, StructureKind};
+pub use thesis::{ThesisStructure, ThesisSummary};

@@ -9,12 +9,21 @@
 //! only if it needs at most [`KEEP_RATIO`] of the global BVH's tests. Counts, not clocks, decide,
 //! so the choice is the same on every run; the answers are the global BVH's either way, so the
 //! image does not change.
+//!
+//! [`build_lights`] traces the pilot through the global BVH before building any buffer, and
+//! builds none for a light too wide next to its pilot segments ([`MAX_EXTENT_RATIO`]): such a
+//! buffer never paid, and costs the most to build. [`prune_by_pilot`] decides for a structure
+//! whose buffers are all built already.
 
 use std::time::Instant;
 
 use rdbvh_core::bvh::TraversalStats;
 
-use super::{render_frame, Camera, FrameSettings, Integrator, LightSet, RenderError, Structure};
+use super::light_structure::{build_buffers, light_groups};
+use super::{
+    render_frame, Camera, FrameSettings, Integrator, LightSet, RenderError, Structure,
+    StructureKind,
+};
 use crate::scene::Scene;
 
 /// The pilot's resolution divides the frame's by this (at least one pixel a side).
@@ -33,8 +42,10 @@ pub struct PilotReport {
     pub shadow_rays: usize,
     /// Light buffers kept.
     pub kept: usize,
-    /// Light buffers dropped (their lights use the global BVH).
+    /// Light buffers dropped (their lights use the global BVH), built or not.
     pub dropped: usize,
+    /// Of those dropped, the ones decided before building ([`build_lights`]).
+    pub skipped: usize,
     /// Wall-clock milliseconds of the pilot and the decision.
     pub ms: f64,
 }
@@ -60,7 +71,6 @@ fn decide(
     let pilot = render_frame(integrator, camera, &settings);
     let n = structure.light_buffers().len();
     let (mut through_buffer, mut through_global) = (vec![0u64; n], vec![0u64; n]);
-    let tests = |s: &TraversalStats| u64::from(s.inner_nodes) + u64::from(s.triangles);
     for s in &pilot.shadow_rays {
         let Some(b) = structure.buffer_of(s.light as usize) else {
             continue;
@@ -74,12 +84,137 @@ fn decide(
         through_buffer[b] += tests(&via_buffer);
         through_global[b] += tests(&via_global);
     }
-    // A buffer no pilot ray used has shown no saving: its light is rarely chosen, or unseen.
-    let pays = |b: usize| {
-        through_global[b] > 0
-            && through_buffer[b] as f64 <= f64::from(KEEP_RATIO) * through_global[b] as f64
+    let keep = (0..n).map(|b| pays(through_buffer[b], through_global[b]));
+    (keep.collect(), pilot.shadow_rays.len())
+}
+
+/// The `lights` structure built with the pilot frame deciding first: the global BVH, the pilot
+/// frame of `camera` (made at [`pilot_size`], `size`) traced through it, then a buffer built only
+/// for the light groups whose pilot segments leave it a chance to pay
+/// ([`MAX_EXTENT_RATIO`]), and of those kept only the ones that need at most [`KEEP_RATIO`] of the
+/// global BVH's tests on the same segments. The pilot's segments do not depend on the
+/// structure (every structure answers alike), so one pilot serves both decisions.
+pub fn build_lights(
+    scene: &Scene,
+    lights: &LightSet,
+    max_bounces: u32,
+    camera: &Camera,
+    size: (u32, u32),
+    seed: u64,
+) -> Result<(Structure, PilotReport), RenderError> {
+    let start = Instant::now();
+    let triangles = &scene.triangles;
+    let mut structure = Structure::build(StructureKind::Global, triangles, lights.lights())?;
+    let groups = light_groups(triangles, lights.lights());
+    let mut group_of = vec![u32::MAX; lights.lights().len()];
+    for (g, group) in groups.iter().enumerate() {
+        for &l in &group.lights {
+            group_of[l as usize] = g as u32;
+        }
+    }
+    let settings = FrameSettings {
+        width: size.0,
+        height: size.1,
+        spp: 1,
+        seed,
+        record_limit: 0,
+        progress: false,
     };
-    ((0..n).map(pays).collect(), pilot.shadow_rays.len())
+    let pilot_start = Instant::now();
+    let pilot = render_frame(
+        &Integrator::new(scene, lights, &structure, max_bounces)?,
+        camera,
+        &settings,
+    );
+    let pilot_ms = pilot_start.elapsed().as_secs_f64() * 1e3;
+    // Per group: its pilot segments, their tests through the global BVH, and their lengths.
+    let mut segments: Vec<Vec<usize>> = vec![Vec::new(); groups.len()];
+    let mut global_tests = vec![0u64; groups.len()];
+    for (i, s) in pilot.shadow_rays.iter().enumerate() {
+        let g = group_of[s.light as usize];
+        if g == u32::MAX {
+            continue;
+        }
+        let mut stats = TraversalStats::default();
+        structure.global().any_hit_with_stats(&s.ray, &mut stats);
+        global_tests[g as usize] += tests(&stats);
+        segments[g as usize].push(i);
+    }
+    let chosen: Vec<usize> = (0..groups.len())
+        .filter(|&g| {
+            let lengths = segments[g].iter().map(|&i| {
+                let r = &pilot.shadow_rays[i].ray;
+                r.dir.length() * (r.t_max - r.t_min)
+            });
+            worth_building(groups[g].extent(), lengths.collect())
+        })
+        .collect();
+    let chosen_groups: Vec<_> = chosen.iter().map(|&g| &groups[g]).collect();
+    let (buffers, buffer_of) = build_buffers(triangles, &chosen_groups, lights.lights().len())?;
+    structure.install_buffers(buffers, buffer_of);
+    let keep: Vec<bool> = chosen
+        .iter()
+        .map(|&g| {
+            let through_buffer: u64 = segments[g]
+                .iter()
+                .map(|&i| {
+                    let s = &pilot.shadow_rays[i];
+                    let mut stats = TraversalStats::default();
+                    structure.occluded_counted(s.light as usize, &s.ray, &mut stats);
+                    tests(&stats)
+                })
+                .sum();
+            pays(through_buffer, global_tests[g])
+        })
+        .collect();
+    structure.keep_buffers(&keep);
+    let ms = start.elapsed().as_secs_f64() * 1e3;
+    structure.set_build_ms(ms);
+    let kept = structure.light_buffers().len();
+    Ok((
+        structure,
+        PilotReport {
+            shadow_rays: pilot.shadow_rays.len(),
+            kept,
+            dropped: groups.len() - kept,
+            skipped: groups.len() - chosen.len(),
+            ms: pilot_ms,
+        },
+    ))
+}
+
+/// Node plus triangle tests.
+fn tests(s: &TraversalStats) -> u64 {
+    u64::from(s.inner_nodes) + u64::from(s.triangles)
+}
+
+/// Whether `through_buffer` tests pay against `through_global` on the same segments. A buffer
+/// no pilot segment used has shown no saving: its light is rarely chosen, or unseen.
+fn pays(through_buffer: u64, through_global: u64) -> bool {
+    through_global > 0 && through_buffer as f64 <= f64::from(KEEP_RATIO) * through_global as f64
+}
+
+/// A light group is worth a buffer only when its width is at most this share of its pilot
+/// segments' median length. A cell's segments sweep the light's whole width, so where the light
+/// is wide next to the distances its shadow rays cross, every cell reaches most of what the
+/// global BVH holds. Measured (512 x 512 frames, default cameras of
+/// `scripts/render-comparison.sh`), width over median length against the buffer's share of the
+/// global BVH's pilot tests: point and spot lights 0 (0.41-0.65, kept), the room's quad 0.39
+/// (0.64, kept), the Cornell box's 0.42 (0.75, dropped by [`KEEP_RATIO`] after its build, which
+/// takes 0.1 ms), Sibenik's window clusters 0.54 and 1.49 (0.91 and 0.98), a quad over the
+/// bunny 1.69 (1.04): above 0.5 no buffer came near paying, and those cost the most to build.
+pub const MAX_EXTENT_RATIO: f32 = 0.5;
+
+/// Whether a light group of width `extent`, whose pilot segments have `lengths`, is worth
+/// building a buffer for: it has pilot segments (a light the pilot never chose is rare or
+/// unseen) and passes [`MAX_EXTENT_RATIO`].
+fn worth_building(extent: f32, mut lengths: Vec<f32>) -> bool {
+    if lengths.is_empty() {
+        return false;
+    }
+    let mid = lengths.len() / 2;
+    let (_, median, _) = lengths.select_nth_unstable_by(mid, f32::total_cmp);
+    extent <= MAX_EXTENT_RATIO * *median
 }
 
 /// The pilot's resolution for a frame of `width` x `height`.
@@ -122,6 +257,7 @@ pub fn prune_by_pilot(
         shadow_rays,
         kept,
         dropped: before - kept,
+        skipped: 0,
         ms,
     })
 }
@@ -129,7 +265,7 @@ pub fn prune_by_pilot(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::{Light, StructureKind};
+    use crate::render::Light;
     use rdbvh_core::geometry::Ray;
     use rdbvh_core::Vec3;
 
@@ -151,6 +287,20 @@ mod tests {
         let camera = Camera::new(eye, at, Vec3::Y, 75.0, size.0, size.1).unwrap();
         let report = prune_by_pilot(&mut structure, &scene, &lights, 1, &camera, size, 7).unwrap();
         (structure, report)
+    }
+
+    #[test]
+    fn wide_lights_next_to_short_segments_get_no_buffer() {
+        assert!(!worth_building(0.0, Vec::new()), "no pilot segment");
+        assert!(worth_building(0.0, vec![3.0, 1.0, 2.0]), "a point light");
+        assert!(
+            worth_building(1.0, vec![3.0, 1.0, 2.0]),
+            "width 1, median 2"
+        );
+        assert!(
+            !worth_building(1.5, vec![3.0, 1.0, 2.0]),
+            "width 1.5, median 2"
+        );
     }
 
     #[test]

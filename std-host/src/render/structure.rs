@@ -2,8 +2,9 @@
 //!
 //! Camera and bounce rays always go through the global BVH. Shadow rays go through the
 //! structure: with `global` the same BVH, with `lights` the light buffer of the ray's light when
-//! it has one, and the global BVH for every segment the buffer does not answer. Both answer every
-//! query exactly as the global BVH does, so the images are byte-identical.
+//! it has one, and the global BVH for every segment the buffer does not answer, with `thesis`
+//! the thesis's influence areas, octree and fallback ([`super::ThesisStructure`]). All answer every query
+//! exactly as the global BVH does, so the images are byte-identical.
 
 use std::time::Instant;
 
@@ -13,6 +14,7 @@ use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::light_buffer::LightBuffer;
 
 use super::light_structure::light_buffers;
+use super::thesis::ThesisStructure;
 use super::{Light, RenderError};
 
 /// Which structure answers the shadow rays (`--structure`).
@@ -25,6 +27,11 @@ pub enum StructureKind {
     /// automatically and kept where a pilot frame's shadow rays show that it pays
     /// ([`super::pilot`]), with the global BVH for what a buffer does not answer.
     Lights,
+    /// The thesis's structure with influence areas made from the lights: six frustums around
+    /// a point light, one along a spot, an oriented box in front of a quad light or an emissive
+    /// cluster; a local BVH per area (PAH), an octree over the areas, and the global BVH as the
+    /// fallback ([`super::ThesisStructure`]).
+    Thesis,
 }
 
 impl StructureKind {
@@ -33,6 +40,7 @@ impl StructureKind {
         match self {
             StructureKind::Global => "global",
             StructureKind::Lights => "lights",
+            StructureKind::Thesis => "thesis",
         }
     }
 }
@@ -45,6 +53,9 @@ pub struct Structure {
     buffers: Vec<LightBuffer>,
     /// Per light (index into the renderer's lights), its buffer's index, or `NO_BUFFER`.
     buffer_of: Vec<u32>,
+    /// The `thesis` structure, which owns the global BVH as its fallback (`global` is then
+    /// empty: no second copy).
+    thesis: Option<ThesisStructure>,
     build_ms: f64,
 }
 
@@ -66,16 +77,27 @@ impl Structure {
             ..BuildOptions::new(Preset::Sah)
         };
         let bvh = options.build(triangles, None)?;
-        let global = WideBvh::from_binary(&bvh, triangles);
+        let mut global = WideBvh::from_binary(&bvh, triangles);
         let (buffers, buffer_of) = match kind {
-            StructureKind::Global => (Vec::new(), vec![NO_BUFFER; lights.len()]),
+            StructureKind::Global | StructureKind::Thesis => {
+                (Vec::new(), vec![NO_BUFFER; lights.len()])
+            }
             StructureKind::Lights => light_buffers(triangles, lights)?,
+        };
+        let thesis = match kind {
+            StructureKind::Thesis => Some(ThesisStructure::build(
+                triangles,
+                lights,
+                std::mem::take(&mut global),
+            )?),
+            _ => None,
         };
         Ok(Self {
             kind,
             global,
             buffers,
             buffer_of,
+            thesis,
             build_ms: start.elapsed().as_secs_f64() * 1e3,
         })
     }
@@ -96,8 +118,17 @@ impl Structure {
     }
 
     /// The global BVH.
+    #[inline]
     pub fn global(&self) -> &WideBvh {
-        &self.global
+        match &self.thesis {
+            Some(t) => t.fallback(),
+            None => &self.global,
+        }
+    }
+
+    /// The `thesis` structure, when that is the kind built.
+    pub fn thesis(&self) -> Option<&ThesisStructure> {
+        self.thesis.as_ref()
     }
 
     /// The index of `light`'s buffer, if it has one.
@@ -126,6 +157,19 @@ impl Structure {
         }
     }
 
+    /// Makes this structure `lights` with `buffers`, `buffer_of` naming each light's buffer
+    /// (or `NO_BUFFER`), for a host that chose which buffers to build ([`super::pilot`]).
+    pub(super) fn install_buffers(&mut self, buffers: Vec<LightBuffer>, buffer_of: Vec<u32>) {
+        self.kind = StructureKind::Lights;
+        self.buffers = buffers;
+        self.buffer_of = buffer_of;
+    }
+
+    /// Sets the build time to what the whole build took, pilot frame included.
+    pub(super) fn set_build_ms(&mut self, ms: f64) {
+        self.build_ms = ms;
+    }
+
     /// Adds work done after the build that belongs to it (the pilot frame) to its time.
     pub(super) fn add_build_ms(&mut self, ms: f64) {
         self.build_ms += ms;
@@ -134,31 +178,37 @@ impl Structure {
     /// The closest hit of a camera or bounce ray: always the global BVH.
     #[inline]
     pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
-        self.global.closest_hit(ray)
+        self.global().closest_hit(ray)
     }
 
     /// Whether anything blocks the shadow segment `ray` toward light `light`.
     #[inline]
     pub fn occluded(&self, light: usize, ray: &Ray) -> bool {
+        if let Some(t) = &self.thesis {
+            return t.occluded(ray);
+        }
         let buffer = self.buffer_of[light];
         if buffer != NO_BUFFER {
             if let Some(answer) = self.buffers[buffer as usize].occluded(ray) {
                 return answer;
             }
         }
-        self.global.any_hit(ray)
+        self.global().any_hit(ray)
     }
 
     /// [`Structure::occluded`], counting node and triangle tests in `stats` (a light buffer's
-    /// cell lookup counts as one inner node).
+    /// cell lookup, and the `thesis` octree's, counts as one inner node).
     #[inline]
     pub fn occluded_counted(&self, light: usize, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        if let Some(t) = &self.thesis {
+            return t.occluded_counted(ray, stats);
+        }
         let buffer = self.buffer_of[light];
         if buffer != NO_BUFFER {
             if let Some(answer) = self.buffers[buffer as usize].occluded_with_stats(ray, stats) {
                 return answer;
             }
         }
-        self.global.any_hit_with_stats(ray, stats)
+        self.global().any_hit_with_stats(ray, stats)
     }
 }

@@ -159,6 +159,114 @@ pub(crate) fn any_prim(
     false
 }
 
+/// What one traversal of a binary BVH does at its leaves: the one part in which closest hit, any
+/// hit and the all-hit walk differ. [`Bvh::traverse`] is the loop they share.
+trait LeafQuery {
+    /// Visit the nearer child first and skip subtrees that enter beyond [`LeafQuery::t_max`]
+    /// (closest hit); unordered queries visit left before right.
+    const ORDERED: bool;
+    /// Where the segment effectively ends now: child boxes are tested up to here.
+    fn t_max(&self) -> f32;
+    /// True when a subtree entered at `t_entry` may still hold what the query wants.
+    fn wants(&self, t_entry: f32) -> bool;
+    /// Tests a leaf's primitives; `true` ends the traversal.
+    fn leaf(&mut self, ids: &[u32]) -> bool;
+    /// An inner node was visited (both child boxes tested).
+    fn inner(&mut self);
+}
+
+/// The closest hit so far.
+struct Closest<'a> {
+    ray: &'a Ray,
+    tris: &'a [Triangle],
+    best: Option<Hit>,
+    stats: &'a mut TraversalStats,
+}
+
+impl LeafQuery for Closest<'_> {
+    const ORDERED: bool = true;
+    #[inline(always)]
+    fn t_max(&self) -> f32 {
+        self.best.map_or(self.ray.t_max, |h| h.t)
+    }
+    #[inline(always)]
+    fn wants(&self, t_entry: f32) -> bool {
+        // The same padded bound the box test used when it admitted the subtree.
+        self.best.is_none_or(|b| t_entry <= pad_far(b.t))
+    }
+    #[inline(always)]
+    fn leaf(&mut self, ids: &[u32]) -> bool {
+        test_prims(ids, self.ray, self.tris, &mut self.best, self.stats);
+        false
+    }
+    #[inline(always)]
+    fn inner(&mut self) {
+        self.stats.inner_nodes += 1;
+    }
+}
+
+/// Any hit: the shadow-ray query, done at the first hit.
+struct Any<'a> {
+    ray: &'a Ray,
+    tris: &'a [Triangle],
+    stats: &'a mut TraversalStats,
+}
+
+impl LeafQuery for Any<'_> {
+    const ORDERED: bool = false;
+    #[inline(always)]
+    fn t_max(&self) -> f32 {
+        self.ray.t_max
+    }
+    #[inline(always)]
+    fn wants(&self, _: f32) -> bool {
+        true
+    }
+    #[inline(always)]
+    fn leaf(&mut self, ids: &[u32]) -> bool {
+        any_prim(ids, self.ray, self.tris, self.stats)
+    }
+    #[inline(always)]
+    fn inner(&mut self) {
+        self.stats.inner_nodes += 1;
+    }
+}
+
+/// Every node and triangle the segment touches, with no early exit.
+struct AllHit<'a> {
+    ray: &'a Ray,
+    tris: &'a [Triangle],
+    stats: AllHitStats,
+}
+
+impl LeafQuery for AllHit<'_> {
+    const ORDERED: bool = false;
+    #[inline(always)]
+    fn t_max(&self) -> f32 {
+        self.ray.t_max
+    }
+    #[inline(always)]
+    fn wants(&self, _: f32) -> bool {
+        true
+    }
+    #[inline(always)]
+    fn leaf(&mut self, ids: &[u32]) -> bool {
+        self.stats.leaves += 1;
+        for &id in ids {
+            self.stats.triangles += 1;
+            let hit = self.tris.get(id as usize);
+            if hit.is_some_and(|t| t.intersect(self.ray, self.ray.t_max).is_some()) {
+                self.stats.hits += 1;
+            }
+        }
+        false
+    }
+    #[inline(always)]
+    fn inner(&mut self) {
+        self.stats.inner_nodes += 1;
+    }
+}
+
 impl Bvh {
     /// The closest hit on `[ray.t_min, ray.t_max]`, or `None`. `tris` are the triangles the BVH
     /// was built over, indexed by primitive id (ids missing from `tris` are skipped).
@@ -176,53 +284,14 @@ impl Bvh {
         tris: &[Triangle],
         stats: &mut TraversalStats,
     ) -> Option<Hit> {
-        let root = self.nodes.first()?;
-        root.bounds().intersect(ray, ray.t_max)?;
-        let mut best: Option<Hit> = None;
-        let mut stack: Stack<_> = Stack::new();
-        let mut index = 0u32;
-        loop {
-            let node = &self.nodes[index as usize];
-            if node.is_leaf() {
-                let first = node.left_first as usize;
-                let ids = &self.prim_indices[first..first + node.count as usize];
-                test_prims(ids, ray, tris, &mut best, stats);
-            } else {
-                stats.inner_nodes += 1;
-                let t_max = best.map_or(ray.t_max, |h| h.t);
-                let l = node.left_first;
-                let tl = self.nodes[l as usize].bounds().intersect(ray, t_max);
-                let tr = self.nodes[l as usize + 1].bounds().intersect(ray, t_max);
-                match (tl, tr) {
-                    (Some(a), Some(b)) => {
-                        let (near, far, t_far) = if a <= b { (l, l + 1, b) } else { (l + 1, l, a) };
-                        stack.push((far, t_far));
-                        index = near;
-                        continue;
-                    }
-                    (Some(_), None) => {
-                        index = l;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        index = l + 1;
-                        continue;
-                    }
-                    (None, None) => {}
-                }
-            }
-            // Pop the next subtree that can still hold a closer hit.
-            loop {
-                let Some((next, t_entry)) = stack.pop() else {
-                    return best;
-                };
-                // The same padded bound the box test used when it admitted the subtree.
-                if best.is_none_or(|b| t_entry <= pad_far(b.t)) {
-                    index = next;
-                    break;
-                }
-            }
-        }
+        let mut query = Closest {
+            ray,
+            tris,
+            best: None,
+            stats,
+        };
+        self.traverse(ray, &mut query);
+        query.best
     }
 
     /// True when any triangle is hit on `[ray.t_min, ray.t_max]`: the shadow-ray query. Stops at
@@ -239,91 +308,81 @@ impl Bvh {
         tris: &[Triangle],
         stats: &mut TraversalStats,
     ) -> bool {
-        let Some(root) = self.nodes.first() else {
-            return false;
-        };
-        if root.bounds().intersect(ray, ray.t_max).is_none() {
-            return false;
-        }
-        let mut stack: Stack<_> = Stack::new();
-        stack.push(0);
-        while let Some(index) = stack.pop() {
-            let node = &self.nodes[index as usize];
-            if node.is_leaf() {
-                let first = node.left_first as usize;
-                if any_prim(
-                    &self.prim_indices[first..first + node.count as usize],
-                    ray,
-                    tris,
-                    stats,
-                ) {
-                    return true;
-                }
-            } else {
-                stats.inner_nodes += 1;
-                let l = node.left_first;
-                // Push the right child first so the left one is visited next; any hit needs no
-                // ordering, only a bounded stack (one pending sibling per level).
-                if self.nodes[l as usize + 1]
-                    .bounds()
-                    .intersect(ray, ray.t_max)
-                    .is_some()
-                {
-                    stack.push(l + 1);
-                }
-                if self.nodes[l as usize]
-                    .bounds()
-                    .intersect(ray, ray.t_max)
-                    .is_some()
-                {
-                    stack.push(l);
-                }
-            }
-        }
-        false
+        self.traverse(ray, &mut Any { ray, tris, stats })
     }
 
     /// The all-hit walk: every node whose box the segment `[ray.t_min, ray.t_max]` touches and
     /// every triangle in those leaves, with no early exit.
     pub fn all_hit(&self, ray: &Ray, tris: &[Triangle]) -> AllHitStats {
-        let mut stats = AllHitStats::default();
+        let mut query = AllHit {
+            ray,
+            tris,
+            stats: AllHitStats::default(),
+        };
+        self.traverse(ray, &mut query);
+        query.stats
+    }
+
+    /// The one traversal loop: from the root, test both children of each inner node, go on to
+    /// one and keep the other on a fixed stack, and hand every leaf reached to `query`. Returns
+    /// true when the query ended it early. The loop keeps the node it is in rather than pushing
+    /// and popping it.
+    #[inline(always)]
+    fn traverse<Q: LeafQuery>(&self, ray: &Ray, query: &mut Q) -> bool {
         let Some(root) = self.nodes.first() else {
-            return stats;
+            return false;
         };
         if root.bounds().intersect(ray, ray.t_max).is_none() {
-            return stats;
+            return false;
         }
-        let mut stack: Stack<_> = Stack::new();
-        stack.push(0);
-        while let Some(index) = stack.pop() {
+        let mut stack: Stack<(u32, f32)> = Stack::new();
+        let mut index = 0u32;
+        loop {
             let node = &self.nodes[index as usize];
             if node.is_leaf() {
-                stats.leaves += 1;
                 let first = node.left_first as usize;
-                for &id in &self.prim_indices[first..first + node.count as usize] {
-                    stats.triangles += 1;
-                    if tris
-                        .get(id as usize)
-                        .is_some_and(|t| t.intersect(ray, ray.t_max).is_some())
-                    {
-                        stats.hits += 1;
-                    }
+                if query.leaf(&self.prim_indices[first..first + node.count as usize]) {
+                    return true;
                 }
             } else {
-                stats.inner_nodes += 1;
+                query.inner();
+                let t_max = query.t_max();
                 let l = node.left_first;
-                for child in [l + 1, l] {
-                    if self.nodes[child as usize]
-                        .bounds()
-                        .intersect(ray, ray.t_max)
-                        .is_some()
-                    {
-                        stack.push(child);
+                let tl = self.nodes[l as usize].bounds().intersect(ray, t_max);
+                let tr = self.nodes[l as usize + 1].bounds().intersect(ray, t_max);
+                match (tl, tr) {
+                    (Some(a), Some(b)) => {
+                        let (near, far, t_far) = if !Q::ORDERED || a <= b {
+                            (l, l + 1, b)
+                        } else {
+                            (l + 1, l, a)
+                        };
+                        stack.push((far, t_far));
+                        index = near;
+                        continue;
                     }
+                    (Some(_), None) => {
+                        index = l;
+                        continue;
+                    }
+                    (None, Some(_)) => {
+                        index = l + 1;
+                        continue;
+                    }
+                    (None, None) => {}
+                }
+            }
+            // Pop the next subtree that can still hold what the query wants.
+            loop {
+                let Some((next, t_entry)) = stack.pop() else {
+                    return false;
+                };
+                if query.wants(t_entry) {
+                    index = next;
+                    break;
                 }
             }
         }
-        stats
     }
 }
 

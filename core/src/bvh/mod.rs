@@ -16,6 +16,7 @@ pub use traversable::Traversable;
 pub use traverse::{AllHitStats, Hit, TraversalStats};
 pub use validate::InvariantError;
 pub use wide::{WideBvh, WideNode};
+pub use wide_traverse::{AnyHit, ClosestHit, HitCount, LeafVisitor};
 
 use crate::geometry::Aabb;
 use crate::heuristics::{CostConstants, CostModel};

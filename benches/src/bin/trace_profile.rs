@@ -1,5 +1,5 @@
 //! `trace_profile SCENE [REPS]`: the four traversal measures of the `peers` table for
-//! `rdbvh-wide` alone (with `--features cpp-peers`, Embree's and tinybvh's BVH8 beside it), in
+//! `rdbvh-wide` and its 8-wide tree `rdbvh-wide8` alone (with `--features cpp-peers`, Embree's and tinybvh's BVH8 beside it), in
 //! interleaved rounds, best thread CPU time of `REPS` (default 7): a quick before/after check of
 //! the traversal kernel that builds in `release` and skips the builds and the Rust peers. SCENE is
 //! a name under `../shared/scenes` or a path to an OBJ file.
@@ -11,7 +11,7 @@
 use std::hint::black_box;
 use std::process::ExitCode;
 
-use rdbvh_benches::peers::{Library, Prepared, RdbvhWide};
+use rdbvh_benches::peers::{Library, Prepared, RdbvhWide, RdbvhWide8};
 use rdbvh_benches::{bounds, load_scene, ray_set, thread_cpu_seconds, RayKind};
 use rdbvh_core::geometry::{Ray, Triangle};
 
@@ -78,15 +78,22 @@ fn main() -> ExitCode {
         .map(|&(_, kind, _)| ray_set(&tris, &b, kind))
         .collect();
     let wide = Traced::<RdbvhWide>::new(&tris, &sets);
+    let wide8 = Traced::<RdbvhWide8>::new(&tris, &sets);
     #[cfg(feature = "cpp-peers")]
     let embree = Traced::<rdbvh_benches::peers::Embree>::new(&tris, &sets);
     #[cfg(feature = "cpp-peers")]
     let tiny = Traced::<rdbvh_benches::peers::TinybvhBvh8>::new(&tris, &sets);
-    let mut best = vec![[f64::INFINITY; 3]; MEASURES.len()];
+    let mut best = vec![[f64::INFINITY; 4]; MEASURES.len()];
     for _ in 0..reps {
         for &m in &chosen {
             let (t, hits) = wide.time(m);
             best[m][0] = best[m][0].min(t);
+            let (t8, hits8) = wide8.time(m);
+            best[m][3] = best[m][3].min(t8);
+            if hits8 != hits {
+                eprintln!("{}: hits {hits} 4-wide, {hits8} 8-wide", MEASURES[m].0);
+                return ExitCode::FAILURE;
+            }
             #[cfg(feature = "cpp-peers")]
             {
                 let (te, he) = embree.time(m);
@@ -109,18 +116,25 @@ fn main() -> ExitCode {
     for &m in &chosen {
         let n = sets[m].len() as f64;
         let rate = |t: f64| n / t * 1e-6;
-        let [w, e, t] = best[m];
+        let [w, e, t, w8] = best[m];
         if e.is_finite() {
             println!(
-                "{:<15} wide {:>7.2}  embree {:>7.2}  tinybvh8 {:>7.2}  ratio {:.2}x",
+                "{:<15} wide {:>6.2} ({:.2}x)  wide8 {:>6.2} ({:.2}x)  embree {:>6.2}  tinybvh8 {:>6.2}",
                 MEASURES[m].0,
                 rate(w),
+                rate(w) / rate(e).max(rate(t)),
+                rate(w8),
+                rate(w8) / rate(e).max(rate(t)),
                 rate(e),
                 rate(t),
-                rate(w) / rate(e).max(rate(t))
             );
         } else {
-            println!("{:<15} wide {:>7.2}", MEASURES[m].0, rate(w));
+            println!(
+                "{:<15} wide {:>6.2}  wide8 {:>6.2}",
+                MEASURES[m].0,
+                rate(w),
+                rate(w8)
+            );
         }
     }
     ExitCode::SUCCESS

@@ -1,42 +1,167 @@
 //! Traversal of 4-wide BVHs: one loop ([`WideBvh::traverse`]) with one 4-wide slab test per node,
 //! and a leaf callback ([`LeafVisitor`]) that makes it closest hit, any hit or the all-hit count.
 
-use wide::f32x4;
+use core::ops::{Add, Mul, Sub};
+
+use wide::{f32x4, f32x8};
 
 use super::traverse::Stack;
-use super::wide::{WideBvh, WideNode};
+use super::wide::{WideBvhN, WideNodeN};
 use super::{AllHitStats, Hit, TraversalStats, MAX_DEPTH};
 use crate::geometry::{pad_far, Ray, RayTri4, Triangle4};
 
-/// Each visited node pops one entry and pushes at most four, so pending entries grow by at most
-/// three per level of the (at most [`MAX_DEPTH`] deep) tree.
-const WIDE_STACK: usize = 3 * MAX_DEPTH as usize + 4;
+/// Each visited node pops one entry and pushes at most eight, so pending entries grow by at most
+/// seven per level of the (at most [`MAX_DEPTH`] deep) tree. Left uninitialised, so the 4-wide
+/// traversal's unused part costs nothing.
+const WIDE_STACK: usize = 7 * MAX_DEPTH as usize + 8;
 
 /// The slab test's relative padding (see `Aabb::slab_interval`), as a vector.
 const PAD: f32 = 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
-/// A ray prepared for 4-wide box tests: splatted origin and inverse direction, and per axis the
-/// row of the node's bounds (see [`planes`]) holding the near and the far planes, chosen once per
-/// ray from the direction's signs.
-struct Ray4 {
-    origin: [f32x4; 3],
-    inv: [f32x4; 3],
+/// The SIMD vector of a node's `W` child lanes: what the slab test needs of it.
+pub trait ChildLanes<const W: usize>:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self>
+{
+    /// Every lane `v`.
+    fn splat(v: f32) -> Self;
+    /// The lanes of one row of a node.
+    fn load(row: [f32; W]) -> Self;
+    /// `max(self, t)` per lane, keeping `self` where `t` is NaN.
+    fn keep_max(self, t: Self) -> Self;
+    /// `min(self, t)` per lane, keeping `self` where `t` is NaN.
+    fn keep_min(self, t: Self) -> Self;
+    /// `|self|` per lane.
+    fn abs(self) -> Self;
+    /// Bit `i` set when lane `i` of `self` is at most that of `other` (false for NaN).
+    fn le_bitmask(self, other: Self) -> u32;
+    /// The lanes.
+    fn to_array(self) -> [f32; W];
+}
+
+impl ChildLanes<4> for f32x4 {
+    #[inline(always)]
+    fn splat(v: f32) -> Self {
+        f32x4::splat(v)
+    }
+    #[inline(always)]
+    fn load(row: [f32; 4]) -> Self {
+        f32x4::from(row)
+    }
+    #[inline(always)]
+    fn keep_max(self, t: Self) -> Self {
+        keep_max(self, t)
+    }
+    #[inline(always)]
+    fn keep_min(self, t: Self) -> Self {
+        keep_min(self, t)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32x4::abs(self)
+    }
+    #[inline(always)]
+    fn le_bitmask(self, other: Self) -> u32 {
+        self.simd_le(other).to_bitmask()
+    }
+    #[inline(always)]
+    fn to_array(self) -> [f32; 4] {
+        f32x4::to_array(self)
+    }
+}
+
+/// With AVX one 8-lane instruction per step, else two 4-lane halves (`wide` picks at compile
+/// time); `fast_max`/`fast_min` keep the accumulator on NaN either way (`maxps`, `vmaxps` and the
+/// halves' [`keep_max`] all return their second operand then).
+impl ChildLanes<8> for f32x8 {
+    #[inline(always)]
+    fn splat(v: f32) -> Self {
+        f32x8::splat(v)
+    }
+    #[inline(always)]
+    fn load(row: [f32; 8]) -> Self {
+        f32x8::from(row)
+    }
+    #[inline(always)]
+    fn keep_max(self, t: Self) -> Self {
+        #[cfg(target_feature = "sse")]
+        {
+            t.fast_max(self)
+        }
+        #[cfg(not(target_feature = "sse"))]
+        {
+            self.max(t)
+        }
+    }
+    #[inline(always)]
+    fn keep_min(self, t: Self) -> Self {
+        #[cfg(target_feature = "sse")]
+        {
+            t.fast_min(self)
+        }
+        #[cfg(not(target_feature = "sse"))]
+        {
+            self.min(t)
+        }
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32x8::abs(self)
+    }
+    #[inline(always)]
+    fn le_bitmask(self, other: Self) -> u32 {
+        self.simd_le(other).to_bitmask()
+    }
+    #[inline(always)]
+    fn to_array(self) -> [f32; 8] {
+        f32x8::to_array(self)
+    }
+}
+
+/// A node width with a SIMD vector for its lanes: 4 (`f32x4`) and 8 (`f32x8`).
+pub struct Width<const W: usize>;
+
+/// The vector type of width `W` ([`Width`]).
+pub trait Lanes<const W: usize> {
+    /// One lane per child.
+    type V: ChildLanes<W>;
+}
+
+impl Lanes<4> for Width<4> {
+    type V = f32x4;
+}
+
+impl Lanes<8> for Width<8> {
+    type V = f32x8;
+}
+
+/// A ray prepared for `W`-wide box tests, once per query: splatted origin and inverse direction,
+/// and per axis the row of the node's bounds (see [`planes`]) holding the near and the far
+/// planes, chosen from the direction's signs.
+struct RayN<V> {
+    origin: [V; 3],
+    inv: [V; 3],
     near: [usize; 3],
     far: [usize; 3],
-    t_min: f32x4,
+    t_min: V,
 }
 
 /// A node's bounds as rows: `min` of axes 0 to 2, then `max` of axes 0 to 2 (then `child` and
 /// `count`, which the slab test never reads).
 #[inline(always)]
-fn planes(node: &WideNode) -> &[[f32; 4]; 8] {
-    bytemuck::cast_ref(node)
+fn planes<const W: usize>(node: &WideNodeN<W>) -> &[[f32; W]; 8] {
+    // SAFETY: `WideNodeN` is `repr(C)`: eight arrays of `W` four-byte values, `32 W` bytes with
+    // no padding (see its `Pod` impls), so it is eight rows of `W` floats; every bit pattern is
+    // a valid `f32`, and the borrow lives as long as the node's.
+    unsafe { &*(node as *const WideNodeN<W>).cast::<[[f32; W]; 8]>() }
 }
 
-impl Ray4 {
+impl<V> RayN<V> {
     #[inline(always)]
-    fn new(ray: &Ray) -> Self {
-        let s = |v: f32| f32x4::splat(v);
+    fn new<const W: usize>(ray: &Ray) -> Self
+    where
+        V: ChildLanes<W>,
+    {
+        let s = |v: f32| V::splat(v);
         Self {
             origin: [s(ray.origin.x), s(ray.origin.y), s(ray.origin.z)],
             inv: [s(ray.inv_dir.x), s(ray.inv_dir.y), s(ray.inv_dir.z)],
@@ -46,25 +171,28 @@ impl Ray4 {
         }
     }
 
-    /// Entry distances of the four children and the bitmask of those the segment up to `t_max`
+    /// Entry distances of the children and the bitmask of those the segment up to `t_max`
     /// touches. Same arithmetic as the scalar `Aabb::slab_interval`: the reduction keeps its
     /// accumulator where a slab value is NaN (a zero direction component with the origin on a
     /// slab plane), and the interval is padded after Ize.
     #[inline(always)]
-    fn intersect(&self, node: &WideNode, t_max: f32) -> (f32x4, u32) {
+    fn intersect<const W: usize>(&self, node: &WideNodeN<W>, t_max: f32) -> (V, u32)
+    where
+        V: ChildLanes<W>,
+    {
         let mut t_near = self.t_min;
-        let mut t_far = f32x4::splat(t_max);
+        let mut t_far = V::splat(t_max);
         let rows = planes(node);
         for k in 0..3 {
             // Rows are below 6; the mask only spares the bounds check.
             let (near, far) = (rows[self.near[k] & 7], rows[self.far[k] & 7]);
-            t_near = keep_max(t_near, (f32x4::from(near) - self.origin[k]) * self.inv[k]);
-            t_far = keep_min(t_far, (f32x4::from(far) - self.origin[k]) * self.inv[k]);
+            t_near = t_near.keep_max((V::load(near) - self.origin[k]) * self.inv[k]);
+            t_far = t_far.keep_min((V::load(far) - self.origin[k]) * self.inv[k]);
         }
-        let pad = f32x4::splat(PAD);
+        let pad = V::splat(PAD);
         let t_near = t_near - t_near.abs() * pad;
         let t_far = t_far + t_far.abs() * pad;
-        (t_near, t_near.simd_le(t_far).to_bitmask())
+        (t_near, t_near.le_bitmask(t_far))
     }
 }
 
@@ -225,7 +353,13 @@ impl LeafVisitor for AnyHit {
 
     #[inline(always)]
     fn leaf(&mut self, blocks: &[Triangle4], _count: u32) -> bool {
-        blocks.iter().any(|b| b.any_hit(&self.ray, self.t_max))
+        // A plain loop: `Iterator::any` here was left out of line.
+        for block in blocks {
+            if block.any_hit(&self.ray, self.t_max) {
+                return true;
+            }
+        }
+        false
     }
 }
 
@@ -266,8 +400,11 @@ impl LeafVisitor for HitCount {
     }
 }
 
-impl WideBvh {
-    /// The one 4-wide traversal: every node whose box the segment up to `visitor.t_max()` touches,
+impl<const W: usize> WideBvhN<W>
+where
+    Width<W>: Lanes<W>,
+{
+    /// The one wide traversal: every node whose box the segment up to `visitor.t_max()` touches,
     /// nearest first when the visitor is ordered, with `visitor` called at each leaf until it
     /// returns true (then this returns true). Closest hit, any hit and the all-hit count are
     /// visitors over it; so can a caller's own leaf test be.
@@ -413,7 +550,7 @@ impl WideBvh {
         visitor: &mut V,
         stats: &mut impl Counters,
     ) -> bool {
-        let r = Ray4::new(ray);
+        let r = RayN::<<Width<W> as Lanes<W>>::V>::new(ray);
         let mut stack: Stack<Entry, WIDE_STACK> = Stack::new();
         let (mut child, mut count) = (root, 0u32);
         loop {
@@ -470,11 +607,11 @@ impl WideBvh {
     }
 }
 
-impl WideBvh {
+impl<const W: usize> WideBvhN<W> {
     /// Hints the cache to fetch the children in `mask`: a node's two lines, or a leaf's first
     /// block's three. A hint only: no fault, no effect on any answer.
     #[inline(always)]
-    fn prefetch(&self, node: &WideNode, mask: u32) {
+    fn prefetch(&self, node: &WideNodeN<W>, mask: u32) {
         #[cfg(target_arch = "x86_64")]
         {
             use core::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
@@ -504,10 +641,10 @@ impl WideBvh {
 /// Pushes the children hit in `first` and `rest` (a mask of at least one more) but the nearest,
 /// farthest first, and returns the nearest.
 #[inline(always)]
-fn push_ordered(
+fn push_ordered<const W: usize, V: ChildLanes<W>>(
     stack: &mut Stack<Entry, WIDE_STACK>,
-    node: &WideNode,
-    t_near: f32x4,
+    node: &WideNodeN<W>,
+    t_near: V,
     first: usize,
     rest: u32,
 ) -> usize {
@@ -523,8 +660,10 @@ fn push_ordered(
         stack.push((node.child[far], node.count[far], t_near[far]));
         return near;
     }
-    // Three or four: sorted by entry, nearest last.
-    let mut hits = [(far, t_near[far]), (near, t_near[near]), (0, 0.0), (0, 0.0)];
+    // Three or more: sorted by entry, nearest last.
+    let mut hits = [(0, 0.0); W];
+    hits[0] = (far, t_near[far]);
+    hits[1] = (near, t_near[near]);
     let mut n = 2;
     let mut m = rest & (rest - 1);
     while m != 0 {
@@ -552,7 +691,7 @@ mod tests {
     use super::*;
     use crate::brute_force;
     use crate::builder::Builder;
-    use crate::bvh::Bvh;
+    use crate::bvh::{Bvh, WideBvh};
     use crate::geometry::Triangle;
     use crate::random::Pcg32;
 
@@ -571,7 +710,9 @@ mod tests {
             let tris = &tris[..n];
             let bvh = Builder::sah().build(tris).unwrap();
             let wide = WideBvh::from_binary(&bvh, tris);
+            let wide8 = crate::bvh::WideBvh8::from_binary(&bvh, tris);
             assert!(wide.max_depth() <= bvh.max_depth());
+            assert!(wide8.max_depth() <= wide.max_depth());
             for i in 0..2000 {
                 let o = v(12.0);
                 let mut d = v(1.0);
@@ -585,6 +726,7 @@ mod tests {
                         continue;
                     };
                     assert_eq!(wide.closest_hit(&r), brute_force::closest_hit(&r, tris));
+                    assert_eq!(wide8.closest_hit(&r), brute_force::closest_hit(&r, tris));
                     continue;
                 }
                 let Ok(r) = Ray::new(o, d) else { continue };
@@ -592,6 +734,9 @@ mod tests {
                 assert_eq!(wide.closest_hit(&r), expect, "ray {i}");
                 assert_eq!(wide.any_hit(&r), expect.is_some());
                 assert_eq!(wide.all_hit(&r).hits, brute_force::hit_count(&r, tris));
+                assert_eq!(wide8.closest_hit(&r), expect, "ray {i}");
+                assert_eq!(wide8.any_hit(&r), expect.is_some());
+                assert_eq!(wide8.all_hit(&r).hits, brute_force::hit_count(&r, tris));
             }
         }
     }

@@ -10,10 +10,36 @@ use super::wide::{WideBvhN, WideNodeN};
 use super::{AllHitStats, Hit, TraversalStats, MAX_DEPTH};
 use crate::geometry::{pad_far, Ray, RayTri4, Triangle4};
 
-/// Each visited node pops one entry and pushes at most eight, so pending entries grow by at most
-/// seven per level of the (at most [`MAX_DEPTH`] deep) tree. Left uninitialised, so the 4-wide
-/// traversal's unused part costs nothing.
-const WIDE_STACK: usize = 7 * MAX_DEPTH as usize + 8;
+/// The pending entries of a `W`-wide traversal: each visited node pops one entry and pushes at
+/// most `W`, so they grow by at most `W - 1` per level of the (at most [`MAX_DEPTH`] deep) tree.
+const fn wide_stack(w: usize) -> usize {
+    (w - 1) * MAX_DEPTH as usize + w
+}
+
+/// A traversal's stack of pending entries, sized per width ([`Lanes::Pending`]).
+pub trait Pending {
+    /// An empty stack.
+    fn new() -> Self;
+    /// Pushes an entry (panics past the depth bound's size, which a valid tree never reaches).
+    fn push(&mut self, entry: Entry);
+    /// Pops the last entry pushed.
+    fn pop(&mut self) -> Option<Entry>;
+}
+
+impl<const N: usize> Pending for Stack<Entry, N> {
+    #[inline(always)]
+    fn new() -> Self {
+        Stack::new()
+    }
+    #[inline(always)]
+    fn push(&mut self, entry: Entry) {
+        Stack::push(self, entry)
+    }
+    #[inline(always)]
+    fn pop(&mut self) -> Option<Entry> {
+        Stack::pop(self)
+    }
+}
 
 /// The slab test's relative padding (see `Aabb::slab_interval`), as a vector.
 const PAD: f32 = 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
@@ -120,18 +146,23 @@ impl ChildLanes<8> for f32x8 {
 /// A node width with a SIMD vector for its lanes: 4 (`f32x4`) and 8 (`f32x8`).
 pub struct Width<const W: usize>;
 
-/// The vector type of width `W` ([`Width`]).
+/// The vector type of width `W` ([`Width`]), and the stack its traversal needs.
 pub trait Lanes<const W: usize> {
     /// One lane per child.
     type V: ChildLanes<W>;
+    /// The pending entries (left uninitialised: only the used part is ever written).
+    #[doc(hidden)]
+    type Pending: Pending;
 }
 
 impl Lanes<4> for Width<4> {
     type V = f32x4;
+    type Pending = Stack<Entry, { wide_stack(4) }>;
 }
 
 impl Lanes<8> for Width<8> {
     type V = f32x8;
+    type Pending = Stack<Entry, { wide_stack(8) }>;
 }
 
 /// A ray prepared for `W`-wide box tests, once per query: splatted origin and inverse direction,
@@ -225,7 +256,7 @@ fn keep_min(acc: f32x4, t: f32x4) -> f32x4 {
 
 /// A pending child: node index or first triangle block, triangle count (0 for a node), entry
 /// distance (kept only by ordered traversals).
-type Entry = (u32, u32, f32);
+pub type Entry = (u32, u32, f32);
 
 /// What a traversal counts: [`TraversalStats`] for the `_with_stats` queries, nothing at all for
 /// the plain ones, whose loops then carry no counter updates.
@@ -551,7 +582,7 @@ where
         stats: &mut impl Counters,
     ) -> bool {
         let r = RayN::<<Width<W> as Lanes<W>>::V>::new(ray);
-        let mut stack: Stack<Entry, WIDE_STACK> = Stack::new();
+        let mut stack = <<Width<W> as Lanes<W>>::Pending as Pending>::new();
         let (mut child, mut count) = (root, 0u32);
         loop {
             if count == 0 {
@@ -642,7 +673,7 @@ impl<const W: usize> WideBvhN<W> {
 /// farthest first, and returns the nearest.
 #[inline(always)]
 fn push_ordered<const W: usize, V: ChildLanes<W>>(
-    stack: &mut Stack<Entry, WIDE_STACK>,
+    stack: &mut impl Pending,
     node: &WideNodeN<W>,
     t_near: V,
     first: usize,

@@ -16,11 +16,12 @@ use criterion::{
     criterion_group, criterion_main, BenchmarkGroup, Criterion, SamplingMode, Throughput,
 };
 use rdbvh_benches::peers::{
-    BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Prepared, Rdbvh, RdbvhWide,
+    BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Prepared, Rdbvh, RdbvhWide, RdbvhWide8,
 };
 use rdbvh_benches::{
     agreement, bounds, load_scene, ray_set, Answers, RayKind, BENCH_SCENES, MIN_AGREEMENT,
 };
+use rdbvh_core::bvh::{AnyHit, ClosestHit};
 use rdbvh_core::geometry::{Ray, Triangle};
 
 /// One library, built once, with the rays of both sets in its own format.
@@ -90,6 +91,7 @@ fn traversals(c: &mut Criterion<Clock>) {
                 .collect();
         let rdbvh = Subject::<Rdbvh>::new(name, &tris, &sets);
         let wide = Subject::<RdbvhWide>::new(name, &tris, &sets);
+        let wide8 = Subject::<RdbvhWide8>::new(name, &tris, &sets);
         let obvhs2 = Subject::<ObvhsBvh2>::new(name, &tris, &sets);
         let obvhs8 = Subject::<ObvhsCwbvh>::new(name, &tris, &sets);
         let bvh = Subject::<BvhCrate>::new(name, &tris, &sets);
@@ -127,6 +129,7 @@ fn traversals(c: &mut Criterion<Clock>) {
                     .measurement_time(Duration::from_secs(2));
                 rdbvh.bench(&mut group, *kind, any);
                 wide.bench(&mut group, *kind, any);
+                wide8.bench(&mut group, *kind, any);
                 obvhs2.bench(&mut group, *kind, any);
                 obvhs8.bench(&mut group, *kind, any);
                 bvh.bench(&mut group, *kind, any);
@@ -140,7 +143,53 @@ fn traversals(c: &mut Criterion<Clock>) {
                 group.finish();
             }
         }
+        skeleton(c, name, &wide.prepared.accel, &sets[1].1);
     }
+}
+
+/// The queries (`closest_hit`, `any_hit`) beside the same visitors run through the public
+/// skeleton (`WideBvh::traverse`), on the random rays: a caller's own leaf callback pays nothing
+/// for going through the shared loop.
+fn skeleton(c: &mut Criterion<Clock>, name: &str, wide: &rdbvh_core::bvh::WideBvh, rays: &[Ray]) {
+    let mut group = c.benchmark_group(format!("traverse/{name}/skeleton-random"));
+    group
+        .throughput(Throughput::Elements(rays.len() as u64))
+        .sampling_mode(SamplingMode::Flat)
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(2));
+    group.bench_function("closest_hit", |b| {
+        b.iter(|| {
+            black_box(rays)
+                .iter()
+                .filter(|r| wide.closest_hit(r).is_some())
+                .count()
+        })
+    });
+    group.bench_function("traverse-ClosestHit", |b| {
+        b.iter(|| {
+            black_box(rays)
+                .iter()
+                .filter(|r| {
+                    let mut v = ClosestHit::new(r);
+                    wide.traverse(r, &mut v);
+                    v.best.is_some()
+                })
+                .count()
+        })
+    });
+    group.bench_function("any_hit", |b| {
+        b.iter(|| black_box(rays).iter().filter(|r| wide.any_hit(r)).count())
+    });
+    group.bench_function("traverse-AnyHit", |b| {
+        b.iter(|| {
+            black_box(rays)
+                .iter()
+                .filter(|r| wide.traverse(r, &mut AnyHit::new(r)))
+                .count()
+        })
+    });
+    group.finish();
 }
 
 criterion_group! {

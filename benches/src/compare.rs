@@ -1,5 +1,5 @@
 //! The peer comparison behind the `peers` binary: one scene, the same triangles and the same rays
-//! for rdbvh (binary and 4-wide), obvhs 0.4, bvh 0.13 and parry3d 0.31, and with the `cpp-peers`
+//! for rdbvh (binary, 4-wide and 8-wide), obvhs 0.4, bvh 0.13 and parry3d 0.31, and with the `cpp-peers`
 //! feature Embree 3; single-threaded and threaded builds, closest hit on camera and random rays,
 //! any hit on random rays and on shadow segments ([`crate::shadow_rays`]); every library's
 //! answers (closest and any hit, on all three ray sets, for the trees of both of its builds)
@@ -33,7 +33,9 @@ use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::{Aabb, Ray, Triangle};
 use rdbvh_core::influence::{InfluenceArea, PlaneArea, PointArea};
 
-use crate::peers::{BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Prepared, Rdbvh, RdbvhWide};
+use crate::peers::{
+    BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Prepared, Rdbvh, RdbvhWide, RdbvhWide8,
+};
 use crate::{
     agreement, bounds, ray_set, single_thread_pool, thread_cpu_seconds, Agreement, Answers,
     RayKind, MIN_AGREEMENT,
@@ -41,12 +43,20 @@ use crate::{
 
 /// The library names of the JSON output, in output order.
 #[cfg(not(feature = "cpp-peers"))]
-pub const LIBRARIES: &[&str] = &["rdbvh", "rdbvh-wide", "obvhs", "bvh", "parry3d"];
+pub const LIBRARIES: &[&str] = &[
+    "rdbvh",
+    "rdbvh-wide",
+    "rdbvh-wide8",
+    "obvhs",
+    "bvh",
+    "parry3d",
+];
 /// The library names of the JSON output, in output order: with the C++ peers.
 #[cfg(feature = "cpp-peers")]
 pub const LIBRARIES: &[&str] = &[
     "rdbvh",
     "rdbvh-wide",
+    "rdbvh-wide8",
     "obvhs",
     "bvh",
     "parry3d",
@@ -550,6 +560,7 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
     // Every tree checked first, then every number measured in interleaved rounds.
     let mut rdbvh = check::<Rdbvh>(tris, &sets, &one, &all)?;
     let mut wide = check::<RdbvhWide>(tris, &sets, &one, &all)?;
+    let mut wide8 = check::<RdbvhWide8>(tris, &sets, &one, &all)?;
     let mut bvh2 = check::<ObvhsBvh2>(tris, &sets, &one, &all)?;
     let mut cwbvh = check::<ObvhsCwbvh>(tris, &sets, &one, &all)?;
     let mut bvh = check::<BvhCrate>(tris, &sets, &one, &all)?;
@@ -577,7 +588,7 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         None
     };
     let mut entries: Vec<&mut dyn Reps> = vec![
-        &mut rdbvh, &mut wide, &mut bvh2, &mut cwbvh, &mut bvh, &mut parry, &mut top,
+        &mut rdbvh, &mut wide, &mut wide8, &mut bvh2, &mut cwbvh, &mut bvh, &mut parry, &mut top,
     ];
     #[cfg(feature = "cpp-peers")]
     entries.extend([
@@ -586,7 +597,7 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         &mut tiny4 as &mut dyn Reps,
     ]);
     // The C++ peers come after the serial top, so the PAH builds are always last.
-    let cpp_entries = entries.len() - 7;
+    let cpp_entries = entries.len() - 8;
     if let Some(p) = pah_reps.as_mut() {
         entries.push(p);
     }
@@ -595,15 +606,16 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
     let mut runs = vec![
         rdbvh.run(&t[0]),
         wide.run(&t[1]),
-        bvh2.run(&t[2]),
-        cwbvh.run(&t[3]),
-        bvh.run(&t[4]),
-        parry.run(&t[5]),
+        wide8.run(&t[2]),
+        bvh2.run(&t[3]),
+        cwbvh.run(&t[4]),
+        bvh.run(&t[5]),
+        parry.run(&t[6]),
     ];
     #[cfg(feature = "cpp-peers")]
-    runs.extend([embree.run(&t[7]), tiny8.run(&t[8]), tiny4.run(&t[9])]);
-    let serial_top = (t[6][0], t[6][1]);
-    let pah = t.get(7 + cpp_entries).map(|p| PahBuilds {
+    runs.extend([embree.run(&t[8]), tiny8.run(&t[9]), tiny4.run(&t[10])]);
+    let serial_top = (t[7][0], t[7][1]);
+    let pah = t.get(8 + cpp_entries).map(|p| PahBuilds {
         sah: p[0],
         full_plane: p[1],
         full_point: p[2],

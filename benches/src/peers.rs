@@ -204,6 +204,44 @@ impl Library for RdbvhWide {
     }
 }
 
+/// [`RdbvhWide`]'s binary tree collapsed to 8-wide nodes ([`rdbvh_core::bvh::WideBvh8`]): half
+/// the levels, so half the dependent node fetches on a ray's path.
+pub struct RdbvhWide8;
+
+impl Library for RdbvhWide8 {
+    const NAME: &'static str = "rdbvh-wide8";
+    const PARALLEL_BUILD: Option<&'static str> =
+        Some("rdbvh::parallel::build, then the single-threaded reinsertion and 8-wide collapse");
+    type Scene = Vec<Triangle>;
+    type Ray = Ray;
+    type Accel = rdbvh_core::bvh::WideBvh8;
+
+    fn scene(tris: &[Triangle]) -> Self::Scene {
+        tris.to_vec()
+    }
+    fn rays(rays: &[Ray]) -> Vec<Ray> {
+        rays.to_vec()
+    }
+    fn build(scene: &mut Self::Scene) -> Self::Accel {
+        let mut bvh = Rdbvh::build(scene);
+        reinsert(&mut bvh, &Sah, &ReinsertConfig::default());
+        rdbvh_core::bvh::WideBvh8::from_binary(&bvh, scene)
+    }
+    fn build_mt(scene: &mut Self::Scene) -> Self::Accel {
+        let mut bvh = Rdbvh::build_mt(scene);
+        reinsert(&mut bvh, &Sah, &ReinsertConfig::default());
+        rdbvh_core::bvh::WideBvh8::from_binary(&bvh, scene)
+    }
+    #[inline]
+    fn closest(accel: &Self::Accel, _scene: &Self::Scene, ray: &Ray) -> Option<f32> {
+        accel.closest_hit(ray).map(|h| h.t)
+    }
+    #[inline]
+    fn any(accel: &Self::Accel, _scene: &Self::Scene, ray: &Ray) -> bool {
+        accel.any_hit(ray)
+    }
+}
+
 /// `bvh` improved by reinsertion under SAH, collapsed to 4-wide nodes over `tris`.
 fn wide_from(mut bvh: rdbvh_core::bvh::Bvh, tris: &[Triangle]) -> rdbvh_core::bvh::WideBvh {
     reinsert(&mut bvh, &Sah, &ReinsertConfig::default());

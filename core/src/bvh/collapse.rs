@@ -36,32 +36,38 @@ pub(crate) const LEAF_BLOCK: usize = 8;
 /// Subtree sizes saturate here: "more than a leaf's two blocks".
 const MORE: u8 = LEAF_BLOCK as u8 + 1;
 
-/// The choices for one binary node.
-#[derive(Clone, Copy, Debug, Default)]
-struct Choice {
+/// The choices for one binary node, for a wide node of `W` slots.
+#[derive(Clone, Copy, Debug)]
+struct Choice<const W: usize> {
     /// In one slot, the node is a wide leaf (else a wide node of its own).
     leaf: bool,
-    /// For `i` = 2, 3, 4 slots: the node takes one slot (else its children share the `i`).
-    single: [bool; 3],
-    /// For `j` = 2, 3, 4 slots shared by the children: how many the left child takes.
-    left: [u8; 3],
+    /// For `i` = 2 to `W` slots (index `i - 2`): the node takes one slot (else its children
+    /// share the `i`).
+    single: [bool; W],
+    /// For `j` = 2 to `W` slots shared by the children (index `j - 2`): how many the left takes.
+    left: [u8; W],
 }
 
 /// The collapse's decisions for every node of a binary BVH.
-pub(crate) struct CollapsePlan {
-    choice: Vec<Choice>,
+pub(crate) struct CollapsePlan<const W: usize> {
+    choice: Vec<Choice<W>>,
     /// The binary root is a leaf or holds at most [`super::WideBvh::ONE_BLOCK`] triangles.
     root_forced: bool,
 }
 
-impl CollapsePlan {
+impl<const W: usize> CollapsePlan<W> {
     /// Prices every node of `bvh` (a valid tree with at least one node) in one post-order pass.
     pub(crate) fn new(bvh: &Bvh) -> Self {
         let n = bvh.nodes.len();
-        let mut choice = alloc::vec![Choice::default(); n];
+        let unset = Choice {
+            leaf: false,
+            single: [false; W],
+            left: [0; W],
+        };
+        let mut choice = alloc::vec![unset; n];
         let mut size = alloc::vec![0u8; n];
         // cost[b][i - 1]: the cheapest cost of binary subtree `b` in at most `i` slots.
-        let mut cost = alloc::vec![[0f32; 4]; n];
+        let mut cost = alloc::vec![[0f32; W]; n];
         // (node, whether its children are done); a valid tree's depth bounds the stack.
         let mut stack: Vec<(u32, bool)> = Vec::with_capacity(2 * MAX_DEPTH as usize + 2);
         stack.push((0, false));
@@ -71,11 +77,11 @@ impl CollapsePlan {
                 let area = node.bounds().half_area();
                 // A binary leaf is a wide leaf, in as many blocks as it needs.
                 size[b as usize] = node.count.min(u32::from(MORE)) as u8;
-                cost[b as usize] = [area * C_BLOCK * node.count.div_ceil(4) as f32; 4];
+                cost[b as usize] = [area * C_BLOCK * node.count.div_ceil(4) as f32; W];
                 choice[b as usize] = Choice {
                     leaf: true,
-                    single: [true; 3],
-                    left: [1; 3],
+                    single: [true; W],
+                    left: [1; W],
                 };
                 continue;
             }
@@ -90,8 +96,8 @@ impl CollapsePlan {
             let s = (size[l] + size[l + 1]).min(MORE);
             size[b as usize] = s;
             // shared[j - 2]: the children's cheapest split of `j` slots, and the left's share.
-            let mut shared = [(f32::INFINITY, 1u8); 3];
-            for (j, best) in (2..=4).zip(&mut shared) {
+            let mut shared = [(f32::INFINITY, 1u8); W];
+            for (j, best) in (2..=W).zip(&mut shared) {
                 for k in 1..j {
                     let c = cost[l][k - 1] + cost[l + 1][j - k - 1];
                     if c < best.0 {
@@ -102,15 +108,15 @@ impl CollapsePlan {
             // At most four triangles: always one leaf (see `LEAF_BLOCK`).
             let forced = u32::from(s) <= super::WideBvh::ONE_BLOCK;
             let leaf_cost = area * C_BLOCK * u32::from(s).div_ceil(4) as f32;
-            let node_cost = area * C_NODE + shared[2].0;
+            let node_cost = area * C_NODE + shared[W - 2].0;
             // Ties go to the leaf and to one slot: fewer nodes. (Boxes of a valid tree are
             // finite, so costs are never NaN; an overflow to infinity ties too.)
             let leaf = forced || (usize::from(s) <= LEAF_BLOCK && leaf_cost <= node_cost);
             let one = if leaf { leaf_cost } else { node_cost };
-            let mut c = [one; 4];
-            let mut single = [true; 3];
+            let mut c = [one; W];
+            let mut single = [true; W];
             if !forced {
-                for (j, &(shared_cost, _)) in shared.iter().enumerate() {
+                for (j, &(shared_cost, _)) in shared[..W - 1].iter().enumerate() {
                     if shared_cost < one {
                         c[j + 1] = shared_cost;
                         single[j] = false;
@@ -141,25 +147,25 @@ impl CollapsePlan {
 
     /// The slots of the wide node standing for binary inner node `b` (one that is not a leaf):
     /// the binary nodes they hold, in left-to-right order, with whether each is a wide leaf.
-    /// Returns how many of `slots` it filled (two to four).
-    pub(crate) fn slots(&self, bvh: &Bvh, b: u32, slots: &mut [(u32, bool); 4]) -> usize {
+    /// Returns how many of `slots` it filled (two to `W`).
+    pub(crate) fn slots(&self, bvh: &Bvh, b: u32, slots: &mut [(u32, bool); W]) -> usize {
         let mut n = 0;
         let l = bvh.nodes[b as usize].left_first;
-        let k = self.choice[b as usize].left[2];
+        let k = self.choice[b as usize].left[W - 2];
         self.gather(bvh, l, usize::from(k), slots, &mut n);
-        self.gather(bvh, l + 1, 4 - usize::from(k), slots, &mut n);
+        self.gather(bvh, l + 1, W - usize::from(k), slots, &mut n);
         n
     }
 
     /// Appends the slots binary node `b` takes when given at most `i` of them.
-    fn gather(&self, bvh: &Bvh, b: u32, i: usize, slots: &mut [(u32, bool); 4], n: &mut usize) {
+    fn gather(&self, bvh: &Bvh, b: u32, i: usize, slots: &mut [(u32, bool); W], n: &mut usize) {
         let choice = &self.choice[b as usize];
         if i == 1 || choice.single[i - 2] {
             slots[*n] = (b, choice.leaf);
             *n += 1;
             return;
         }
-        // `i` is at most four and each share at least one less, so this recursion is shallow.
+        // `i` is at most `W` and each share at least one less, so this recursion is shallow.
         let l = bvh.nodes[b as usize].left_first;
         let k = usize::from(choice.left[i - 2]);
         self.gather(bvh, l, k, slots, n);

@@ -15,7 +15,8 @@ pub use node::BvhNode;
 pub use traversable::Traversable;
 pub use traverse::{AllHitStats, Hit, TraversalStats};
 pub use validate::InvariantError;
-pub use wide::{WideBvh, WideNode};
+pub use wide::{WideBvh, WideBvh8, WideBvhN, WideNode, WideNode8, WideNodeN};
+pub use wide_traverse::{AnyHit, ChildLanes, ClosestHit, HitCount, Lanes, LeafVisitor, Width};
 
 use crate::geometry::Aabb;
 use crate::heuristics::{CostConstants, CostModel};

@@ -2,7 +2,7 @@
 //! BVH, so a [`crate::toplevel::TopLevel`]'s local and fallback trees can be either, statically
 //! dispatched.
 
-use super::{Bvh, Hit, TraversalStats, WideBvh};
+use super::{Bvh, Hit, Lanes, TraversalStats, WideBvhN, Width};
 use crate::geometry::{Ray, Triangle, Triangle4};
 
 /// Closest-hit and any-hit queries over the triangles a hierarchy was built from, with the work
@@ -72,9 +72,12 @@ impl Traversable for Bvh {
     }
 }
 
-/// The wide tree answers from its own copy of the triangles (made by [`WideBvh::from_binary`]
+/// The wide tree answers from its own copy of the triangles (made by [`WideBvhN::from_binary`]
 /// from the array the scene passes here), so it ignores `tris`.
-impl Traversable for WideBvh {
+impl<const W: usize> Traversable for WideBvhN<W>
+where
+    Width<W>: Lanes<W>,
+{
     #[inline]
     fn closest_hit_with_stats(
         &self,
@@ -82,7 +85,7 @@ impl Traversable for WideBvh {
         _tris: &[Triangle],
         stats: &mut TraversalStats,
     ) -> Option<Hit> {
-        WideBvh::closest_hit_with_stats(self, ray, stats)
+        WideBvhN::closest_hit_with_stats(self, ray, stats)
     }
 
     #[inline]
@@ -92,17 +95,17 @@ impl Traversable for WideBvh {
         _tris: &[Triangle],
         stats: &mut TraversalStats,
     ) -> bool {
-        WideBvh::any_hit_with_stats(self, ray, stats)
+        WideBvhN::any_hit_with_stats(self, ray, stats)
     }
 
     #[inline]
     fn closest_hit(&self, ray: &Ray, _tris: &[Triangle]) -> Option<Hit> {
-        WideBvh::closest_hit(self, ray)
+        WideBvhN::closest_hit(self, ray)
     }
 
     #[inline]
     fn any_hit(&self, ray: &Ray, _tris: &[Triangle]) -> bool {
-        WideBvh::any_hit(self, ray)
+        WideBvhN::any_hit(self, ray)
     }
 
     fn prim_count(&self) -> usize {
@@ -114,6 +117,6 @@ impl Traversable for WideBvh {
     }
 
     fn memory_bytes(&self) -> usize {
-        WideBvh::memory_bytes(self)
+        WideBvhN::memory_bytes(self)
     }
 }

@@ -77,7 +77,7 @@ const STACK_SIZE: usize = MAX_DEPTH as usize + 1;
 /// The stack's storage is left uninitialised: filling a wide traversal's 196 entries cost every ray
 /// a 2 KiB `memset` (8% of a camera-ray traversal on Sponza). Entries below `len` are always
 /// initialised, since `push` is the only writer and `pop` reads only below `len`.
-pub(crate) struct Stack<T: Copy, const N: usize = STACK_SIZE> {
+pub struct Stack<T: Copy, const N: usize = STACK_SIZE> {
     items: [MaybeUninit<T>; N],
     len: usize,
 }

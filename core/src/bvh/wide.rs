@@ -10,37 +10,57 @@ use super::collapse::{CollapsePlan, LEAF_BLOCK};
 use super::{Bvh, BvhNode, MAX_DEPTH};
 use crate::geometry::{Aabb, Triangle, Triangle4};
 
-/// A 4-wide node, 128 bytes on a 64-byte boundary: the four child boxes as `min`/`max` lanes per
-/// axis (one `f32x4` load each), then per child either an inner node index (`count == 0`), a leaf's
-/// first [`Triangle4`] block (`count > 0` triangles, in `ceil(count / 4)` blocks), or nothing (`child == EMPTY`, with an inverted box that no
-/// ray can hit, so the slab test needs no mask).
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+/// A wide node of `W` children (4 or 8), `32 W` bytes on a 64-byte boundary: the children's
+/// boxes as `min`/`max` lanes per axis (one `W`-lane load each), then per child either an inner
+/// node index (`count == 0`), a leaf's first [`Triangle4`] block (`count > 0` triangles, in
+/// `ceil(count / 4)` blocks), or nothing (`child == EMPTY`, with an inverted box that no ray can
+/// hit, so the slab test needs no mask).
+#[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
-pub struct WideNode {
-    /// Lower bounds of the four children, per axis.
-    pub min: [[f32; 4]; 3],
-    /// Upper bounds of the four children, per axis.
-    pub max: [[f32; 4]; 3],
-    /// Child node index, or first triangle block of a leaf child, or [`WideNode::EMPTY`].
-    pub child: [u32; 4],
+pub struct WideNodeN<const W: usize> {
+    /// Lower bounds of the children, per axis.
+    pub min: [[f32; W]; 3],
+    /// Upper bounds of the children, per axis.
+    pub max: [[f32; W]; 3],
+    /// Child node index, or first triangle block of a leaf child, or [`WideNodeN::EMPTY`].
+    pub child: [u32; W],
     /// Triangles of a leaf child; zero for an inner child or an empty slot.
-    pub count: [u32; 4],
+    pub count: [u32; W],
 }
+
+/// The 4-wide node: 128 bytes, its child boxes tested with one `f32x4` per plane.
+pub type WideNode = WideNodeN<4>;
+
+/// The 8-wide node: 256 bytes, its child boxes tested with one `f32x8` per plane (two 4-wide
+/// halves without AVX).
+pub type WideNode8 = WideNodeN<8>;
+
+// SAFETY: every field is an array of `f32` or `u32` (any bit pattern valid, zero included), and
+// `32 W` bytes of fields fill the 64-byte alignment exactly for W = 4 and 8: no padding.
+unsafe impl Zeroable for WideNodeN<4> {}
+// SAFETY: as above.
+unsafe impl Pod for WideNodeN<4> {}
+// SAFETY: as above.
+unsafe impl Zeroable for WideNodeN<8> {}
+// SAFETY: as above.
+unsafe impl Pod for WideNodeN<8> {}
 
 static_assertions::assert_eq_size!(WideNode, [u8; 128]);
 static_assertions::const_assert_eq!(core::mem::align_of::<WideNode>(), 64);
 static_assertions::const_assert_eq!(core::mem::offset_of!(WideNode, min), 0);
 static_assertions::const_assert_eq!(core::mem::offset_of!(WideNode, max), 48);
+static_assertions::assert_eq_size!(WideNode8, [u8; 256]);
+static_assertions::const_assert_eq!(core::mem::offset_of!(WideNode8, max), 96);
 
-impl WideNode {
+impl<const W: usize> WideNodeN<W> {
     /// The `child` value of an unused slot.
     pub const EMPTY: u32 = u32::MAX;
 
-    const UNUSED: WideNode = WideNode {
-        min: [[f32::INFINITY; 4]; 3],
-        max: [[f32::NEG_INFINITY; 4]; 3],
-        child: [Self::EMPTY; 4],
-        count: [0; 4],
+    const UNUSED: Self = Self {
+        min: [[f32::INFINITY; W]; 3],
+        max: [[f32::NEG_INFINITY; W]; 3],
+        child: [Self::EMPTY; W],
+        count: [0; W],
     };
 
     /// The box of slot `i` (empty for an unused slot).
@@ -66,8 +86,8 @@ impl WideNode {
     }
 }
 
-/// A 4-wide BVH with its own copy of the triangles, in leaf order and laid out for the 4-wide
-/// triangle test ([`Triangle4`] blocks: a leaf tests four triangles per step, with no indirection
+/// A wide BVH of `W` children per node (4: [`WideBvh`], 8: [`WideBvh8`]) with its own copy of the
+/// triangles, in leaf order and laid out for the 4-wide triangle test ([`Triangle4`] blocks: a leaf tests four triangles per step, with no indirection
 /// through a primitive-index array). The root is node 0; a BVH whose binary root becomes a leaf
 /// (see [`WideBvh::from_binary`]) gets a root with that leaf as its only child.
 ///
@@ -91,8 +111,8 @@ impl WideNode {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct WideBvh {
-    pub(crate) nodes: Vec<WideNode>,
+pub struct WideBvhN<const W: usize> {
+    pub(crate) nodes: Vec<WideNodeN<W>>,
     pub(crate) tris: Vec<Triangle4>,
     pub(crate) max_depth: u32,
     bounds: Aabb,
@@ -103,14 +123,22 @@ pub struct WideBvh {
     pub(crate) root_max: f32x4,
 }
 
-impl WideBvh {
+/// The 4-wide BVH: the width whose node and triangle-test counts the renderer's and the CLI's
+/// counters compare structures at.
+pub type WideBvh = WideBvhN<4>;
+
+/// The 8-wide BVH: half the levels of the 4-wide tree's, so half the dependent node fetches on a
+/// ray's path, for the same triangle blocks.
+pub type WideBvh8 = WideBvhN<8>;
+
+impl<const W: usize> WideBvhN<W> {
     /// A binary subtree of at most this many triangles always becomes one leaf of the wide tree,
     /// in one [`Triangle4`] block, whatever its shape: one 4-wide test replaces the subtree's box
     /// tests and its one or two scalar leaf tests. So a binary build meant only for the collapse
     /// need not split such nodes ([`crate::builder::Builder::for_wide`]).
     pub const ONE_BLOCK: u32 = 4;
 
-    /// Collapses a binary BVH built over `tris` into the 4-wide tree of least SAH cost that keeps
+    /// Collapses a binary BVH built over `tris` into the `W`-wide tree of least SAH cost that keeps
     /// its subtrees (node and block tests priced alike; `core/src/bvh/collapse.rs`): each wide
     /// node stands for a binary node and takes two to four of its descendants as slots, chosen by
     /// dynamic programming over the binary tree. A binary subtree of at most four triangles
@@ -120,7 +148,7 @@ impl WideBvh {
     pub fn from_binary(bvh: &Bvh, tris: &[Triangle]) -> Self {
         let mut out = Self::collapse(bvh, tris);
         let root = out.nodes.first().map_or(Aabb::EMPTY, |root| {
-            (0..4).fold(Aabb::EMPTY, |b, i| b.union(root.child_bounds(i)))
+            (0..W).fold(Aabb::EMPTY, |b, i| b.union(root.child_bounds(i)))
         });
         let (lo, hi) = (root.min, root.max);
         out.root_min = f32x4::from([lo.x, lo.y, lo.z, f32::NEG_INFINITY]);
@@ -130,7 +158,7 @@ impl WideBvh {
 
     /// [`WideBvh::from_binary`] but for the root's box.
     fn collapse(bvh: &Bvh, tris: &[Triangle]) -> Self {
-        let mut out = WideBvh {
+        let mut out = Self {
             nodes: Vec::with_capacity(bvh.nodes.len() / 4 + 1),
             tris: Vec::with_capacity(bvh.prim_indices.len() / 2 + 1),
             max_depth: 0,
@@ -141,18 +169,18 @@ impl WideBvh {
         if bvh.nodes.is_empty() {
             return out;
         }
-        out.nodes.push(WideNode::UNUSED);
-        let plan = CollapsePlan::new(bvh);
+        out.nodes.push(WideNodeN::UNUSED);
+        let plan = CollapsePlan::<W>::new(bvh);
         if plan.root_is_leaf() {
             out.push_leaf(0, 0, bvh, 0, tris);
             return out;
         }
         // (wide node to fill, binary inner node whose subtree it stands for, depth)
-        let mut stack: Vec<(u32, u32, u32)> = Vec::with_capacity(MAX_DEPTH as usize * 3 + 1);
+        let mut stack: Vec<(u32, u32, u32)> = Vec::with_capacity(MAX_DEPTH as usize * (W - 1) + 1);
         stack.push((0, 0, 0));
         while let Some((wide, binary, depth)) = stack.pop() {
             out.max_depth = out.max_depth.max(depth);
-            let mut slots = [(0u32, false); 4];
+            let mut slots = [(0u32, false); W];
             let n = plan.slots(bvh, binary, &mut slots);
             for (slot, &(b, leaf)) in slots[..n].iter().enumerate() {
                 if leaf {
@@ -160,7 +188,7 @@ impl WideBvh {
                 } else {
                     let child: &BvhNode = &bvh.nodes[b as usize];
                     let index = out.nodes.len() as u32;
-                    out.nodes.push(WideNode::UNUSED);
+                    out.nodes.push(WideNodeN::UNUSED);
                     out.nodes[wide as usize].set(slot, child.bounds(), index, 0);
                     stack.push((index, b, depth + 1));
                 }
@@ -202,7 +230,7 @@ impl WideBvh {
         }
     }
     /// The nodes, root first.
-    pub fn nodes(&self) -> &[WideNode] {
+    pub fn nodes(&self) -> &[WideNodeN<W>] {
         &self.nodes
     }
 
@@ -224,7 +252,7 @@ impl WideBvh {
 
     /// Bytes of the node and triangle arrays.
     pub fn memory_bytes(&self) -> usize {
-        self.nodes.len() * core::mem::size_of::<WideNode>()
+        self.nodes.len() * core::mem::size_of::<WideNodeN<W>>()
             + self.tris.len() * core::mem::size_of::<Triangle4>()
     }
 
@@ -232,7 +260,7 @@ impl WideBvh {
     /// index of its root node (`None` for an empty `other`): one allocation holds a forest of
     /// trees, each traversed from its own root ([`WideBvh::any_hit_from`]), laid out in the order
     /// they were appended. The result's own root, bounds and root box stay this tree's.
-    pub(crate) fn append(&mut self, other: &WideBvh) -> Option<u32> {
+    pub(crate) fn append(&mut self, other: &Self) -> Option<u32> {
         if other.nodes.is_empty() {
             return None;
         }
@@ -240,7 +268,7 @@ impl WideBvh {
         self.nodes.extend(other.nodes.iter().map(|node| {
             let mut node = *node;
             for (child, &count) in node.child.iter_mut().zip(&node.count) {
-                if *child != WideNode::EMPTY {
+                if *child != WideNodeN::<W>::EMPTY {
                     *child += if count == 0 { nodes } else { blocks };
                 }
             }

@@ -1,41 +1,198 @@
-//! Traversal of 4-wide BVHs: one 4-wide slab test per node, nearest children first.
+//! Traversal of 4-wide BVHs: one loop ([`WideBvh::traverse`]) with one 4-wide slab test per node,
+//! and a leaf callback ([`LeafVisitor`]) that makes it closest hit, any hit or the all-hit count.
 
-use wide::f32x4;
+use core::ops::{Add, Mul, Sub};
+
+use wide::{f32x4, f32x8};
 
 use super::traverse::Stack;
-use super::wide::{WideBvh, WideNode};
-use super::{Hit, TraversalStats, MAX_DEPTH};
-use crate::geometry::{pad_far, Ray, RayTri4};
+use super::wide::{WideBvhN, WideNodeN};
+use super::{AllHitStats, Hit, TraversalStats, MAX_DEPTH};
+use crate::geometry::{pad_far, Ray, RayTri4, Triangle4};
 
-/// Each visited node pops one entry and pushes at most four, so pending entries grow by at most
-/// three per level of the (at most [`MAX_DEPTH`] deep) tree.
-const WIDE_STACK: usize = 3 * MAX_DEPTH as usize + 4;
+/// The pending entries of a `W`-wide traversal: each visited node pops one entry and pushes at
+/// most `W`, so they grow by at most `W - 1` per level of the (at most [`MAX_DEPTH`] deep) tree.
+const fn wide_stack(w: usize) -> usize {
+    (w - 1) * MAX_DEPTH as usize + w
+}
+
+/// A traversal's stack of pending entries, sized per width ([`Lanes::Pending`]).
+pub trait Pending {
+    /// An empty stack.
+    fn new() -> Self;
+    /// Pushes an entry (panics past the depth bound's size, which a valid tree never reaches).
+    fn push(&mut self, entry: Entry);
+    /// Pops the last entry pushed.
+    fn pop(&mut self) -> Option<Entry>;
+}
+
+impl<const N: usize> Pending for Stack<Entry, N> {
+    #[inline(always)]
+    fn new() -> Self {
+        Stack::new()
+    }
+    #[inline(always)]
+    fn push(&mut self, entry: Entry) {
+        Stack::push(self, entry)
+    }
+    #[inline(always)]
+    fn pop(&mut self) -> Option<Entry> {
+        Stack::pop(self)
+    }
+}
 
 /// The slab test's relative padding (see `Aabb::slab_interval`), as a vector.
 const PAD: f32 = 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
-/// A ray prepared for 4-wide box tests: splatted origin and inverse direction, and per axis the
-/// row of the node's bounds (see [`planes`]) holding the near and the far planes, chosen once per
-/// ray from the direction's signs.
-struct Ray4 {
-    origin: [f32x4; 3],
-    inv: [f32x4; 3],
+/// The SIMD vector of a node's `W` child lanes: what the slab test needs of it.
+pub trait ChildLanes<const W: usize>:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self>
+{
+    /// Every lane `v`.
+    fn splat(v: f32) -> Self;
+    /// The lanes of one row of a node.
+    fn load(row: [f32; W]) -> Self;
+    /// `max(self, t)` per lane, keeping `self` where `t` is NaN.
+    fn keep_max(self, t: Self) -> Self;
+    /// `min(self, t)` per lane, keeping `self` where `t` is NaN.
+    fn keep_min(self, t: Self) -> Self;
+    /// `|self|` per lane.
+    fn abs(self) -> Self;
+    /// Bit `i` set when lane `i` of `self` is at most that of `other` (false for NaN).
+    fn le_bitmask(self, other: Self) -> u32;
+    /// The lanes.
+    fn to_array(self) -> [f32; W];
+}
+
+impl ChildLanes<4> for f32x4 {
+    #[inline(always)]
+    fn splat(v: f32) -> Self {
+        f32x4::splat(v)
+    }
+    #[inline(always)]
+    fn load(row: [f32; 4]) -> Self {
+        f32x4::from(row)
+    }
+    #[inline(always)]
+    fn keep_max(self, t: Self) -> Self {
+        keep_max(self, t)
+    }
+    #[inline(always)]
+    fn keep_min(self, t: Self) -> Self {
+        keep_min(self, t)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32x4::abs(self)
+    }
+    #[inline(always)]
+    fn le_bitmask(self, other: Self) -> u32 {
+        self.simd_le(other).to_bitmask()
+    }
+    #[inline(always)]
+    fn to_array(self) -> [f32; 4] {
+        f32x4::to_array(self)
+    }
+}
+
+/// With AVX one 8-lane instruction per step, else two 4-lane halves (`wide` picks at compile
+/// time); `fast_max`/`fast_min` keep the accumulator on NaN either way (`maxps`, `vmaxps` and the
+/// halves' [`keep_max`] all return their second operand then).
+impl ChildLanes<8> for f32x8 {
+    #[inline(always)]
+    fn splat(v: f32) -> Self {
+        f32x8::splat(v)
+    }
+    #[inline(always)]
+    fn load(row: [f32; 8]) -> Self {
+        f32x8::from(row)
+    }
+    #[inline(always)]
+    fn keep_max(self, t: Self) -> Self {
+        #[cfg(target_feature = "sse")]
+        {
+            t.fast_max(self)
+        }
+        #[cfg(not(target_feature = "sse"))]
+        {
+            self.max(t)
+        }
+    }
+    #[inline(always)]
+    fn keep_min(self, t: Self) -> Self {
+        #[cfg(target_feature = "sse")]
+        {
+            t.fast_min(self)
+        }
+        #[cfg(not(target_feature = "sse"))]
+        {
+            self.min(t)
+        }
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32x8::abs(self)
+    }
+    #[inline(always)]
+    fn le_bitmask(self, other: Self) -> u32 {
+        self.simd_le(other).to_bitmask()
+    }
+    #[inline(always)]
+    fn to_array(self) -> [f32; 8] {
+        f32x8::to_array(self)
+    }
+}
+
+/// A node width with a SIMD vector for its lanes: 4 (`f32x4`) and 8 (`f32x8`).
+pub struct Width<const W: usize>;
+
+/// The vector type of width `W` ([`Width`]), and the stack its traversal needs.
+pub trait Lanes<const W: usize> {
+    /// One lane per child.
+    type V: ChildLanes<W>;
+    /// The pending entries (left uninitialised: only the used part is ever written).
+    #[doc(hidden)]
+    type Pending: Pending;
+}
+
+impl Lanes<4> for Width<4> {
+    type V = f32x4;
+    type Pending = Stack<Entry, { wide_stack(4) }>;
+}
+
+impl Lanes<8> for Width<8> {
+    type V = f32x8;
+    type Pending = Stack<Entry, { wide_stack(8) }>;
+}
+
+/// A ray prepared for `W`-wide box tests, once per query: splatted origin and inverse direction,
+/// and per axis the row of the node's bounds (see [`planes`]) holding the near and the far
+/// planes, chosen from the direction's signs.
+struct RayN<V> {
+    origin: [V; 3],
+    inv: [V; 3],
     near: [usize; 3],
     far: [usize; 3],
-    t_min: f32x4,
+    t_min: V,
 }
 
 /// A node's bounds as rows: `min` of axes 0 to 2, then `max` of axes 0 to 2 (then `child` and
 /// `count`, which the slab test never reads).
 #[inline(always)]
-fn planes(node: &WideNode) -> &[[f32; 4]; 8] {
-    bytemuck::cast_ref(node)
+fn planes<const W: usize>(node: &WideNodeN<W>) -> &[[f32; W]; 8] {
+    // SAFETY: `WideNodeN` is `repr(C)`: eight arrays of `W` four-byte values, `32 W` bytes with
+    // no padding (see its `Pod` impls), so it is eight rows of `W` floats; every bit pattern is
+    // a valid `f32`, and the borrow lives as long as the node's.
+    unsafe { &*(node as *const WideNodeN<W>).cast::<[[f32; W]; 8]>() }
 }
 
-impl Ray4 {
+impl<V> RayN<V> {
     #[inline(always)]
-    fn new(ray: &Ray) -> Self {
-        let s = |v: f32| f32x4::splat(v);
+    fn new<const W: usize>(ray: &Ray) -> Self
+    where
+        V: ChildLanes<W>,
+    {
+        let s = |v: f32| V::splat(v);
         Self {
             origin: [s(ray.origin.x), s(ray.origin.y), s(ray.origin.z)],
             inv: [s(ray.inv_dir.x), s(ray.inv_dir.y), s(ray.inv_dir.z)],
@@ -45,25 +202,28 @@ impl Ray4 {
         }
     }
 
-    /// Entry distances of the four children and the bitmask of those the segment up to `t_max`
+    /// Entry distances of the children and the bitmask of those the segment up to `t_max`
     /// touches. Same arithmetic as the scalar `Aabb::slab_interval`: the reduction keeps its
     /// accumulator where a slab value is NaN (a zero direction component with the origin on a
     /// slab plane), and the interval is padded after Ize.
     #[inline(always)]
-    fn intersect(&self, node: &WideNode, t_max: f32) -> (f32x4, u32) {
+    fn intersect<const W: usize>(&self, node: &WideNodeN<W>, t_max: f32) -> (V, u32)
+    where
+        V: ChildLanes<W>,
+    {
         let mut t_near = self.t_min;
-        let mut t_far = f32x4::splat(t_max);
+        let mut t_far = V::splat(t_max);
         let rows = planes(node);
         for k in 0..3 {
             // Rows are below 6; the mask only spares the bounds check.
             let (near, far) = (rows[self.near[k] & 7], rows[self.far[k] & 7]);
-            t_near = keep_max(t_near, (f32x4::from(near) - self.origin[k]) * self.inv[k]);
-            t_far = keep_min(t_far, (f32x4::from(far) - self.origin[k]) * self.inv[k]);
+            t_near = t_near.keep_max((V::load(near) - self.origin[k]) * self.inv[k]);
+            t_far = t_far.keep_min((V::load(far) - self.origin[k]) * self.inv[k]);
         }
-        let pad = f32x4::splat(PAD);
+        let pad = V::splat(PAD);
         let t_near = t_near - t_near.abs() * pad;
         let t_far = t_far + t_far.abs() * pad;
-        (t_near, t_near.simd_le(t_far).to_bitmask())
+        (t_near, t_near.le_bitmask(t_far))
     }
 }
 
@@ -94,12 +254,13 @@ fn keep_min(acc: f32x4, t: f32x4) -> f32x4 {
     }
 }
 
-/// A pending child: node index or first triangle block, triangle count (0 for a node), entry.
-type Entry = (u32, u32, f32);
+/// A pending child: node index or first triangle block, triangle count (0 for a node), entry
+/// distance (kept only by ordered traversals).
+pub type Entry = (u32, u32, f32);
 
 /// What a traversal counts: [`TraversalStats`] for the `_with_stats` queries, nothing at all for
 /// the plain ones, whose loops then carry no counter updates.
-trait Counters {
+pub(crate) trait Counters {
     fn node(&mut self);
     fn leaf(&mut self, triangles: u32);
 }
@@ -123,7 +284,182 @@ impl Counters for () {
     fn leaf(&mut self, _: u32) {}
 }
 
-impl WideBvh {
+/// The leaf callback of the one 4-wide traversal ([`WideBvh::traverse`]): closest hit, any hit
+/// and the all-hit count are each a visitor over the same loop, which is monomorphised per
+/// visitor, so each query compiles to its own loop with nothing of the others in it.
+pub trait LeafVisitor {
+    /// True: children are visited nearest first and a pending subtree is dropped once it starts
+    /// beyond [`LeafVisitor::t_max`] (closest hit). False: children in slot order, no distances
+    /// kept (queries whose segment never shortens).
+    const ORDERED: bool;
+
+    /// The end of the segment still searched: the closest hit so far for a closest-hit query,
+    /// the ray's `t_max` otherwise. Nodes and pending subtrees beyond it are skipped.
+    fn t_max(&self) -> f32;
+
+    /// Visits one leaf: `count` triangles in `blocks` (`ceil(count / 4)` blocks, unused lanes
+    /// after the last). Returns true to end the traversal (an any-hit query's first hit).
+    fn leaf(&mut self, blocks: &[Triangle4], count: u32) -> bool;
+}
+
+/// Closest hit: keeps the closest hit under [`Hit::is_closer_than`] and shortens the segment to it.
+pub struct ClosestHit {
+    ray: RayTri4,
+    /// The closest hit so far.
+    pub best: Option<Hit>,
+    t_max: f32,
+}
+
+impl ClosestHit {
+    /// A query along `ray`, nothing hit yet.
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> Self {
+        Self {
+            ray: RayTri4::new(ray),
+            best: None,
+            t_max: ray.t_max,
+        }
+    }
+}
+
+impl LeafVisitor for ClosestHit {
+    const ORDERED: bool = true;
+
+    #[inline(always)]
+    fn t_max(&self) -> f32 {
+        self.t_max
+    }
+
+    /// Every lane hit in a block lies within the segment as it was before the block, so the
+    /// closest of them under the tie rule, compared with `best`, is what the scalar loop (which
+    /// shortens the segment after each hit) finds.
+    #[inline(always)]
+    fn leaf(&mut self, blocks: &[Triangle4], _count: u32) -> bool {
+        for block in blocks {
+            let h = block.intersect(&self.ray, self.t_max);
+            let mut m = h.mask;
+            while m != 0 {
+                let j = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let hit = Hit {
+                    t: h.t[j],
+                    triangle: block.id[j],
+                    u: h.u[j],
+                    v: h.v[j],
+                };
+                if self.best.is_none_or(|b| hit.is_closer_than(&b)) {
+                    self.best = Some(hit);
+                    self.t_max = hit.t;
+                }
+            }
+        }
+        false
+    }
+}
+
+/// Any hit: ends the traversal at the first triangle hit on the segment.
+pub struct AnyHit {
+    ray: RayTri4,
+    t_max: f32,
+}
+
+impl AnyHit {
+    /// A query along `ray`.
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> Self {
+        Self {
+            ray: RayTri4::new(ray),
+            t_max: ray.t_max,
+        }
+    }
+}
+
+impl LeafVisitor for AnyHit {
+    const ORDERED: bool = false;
+
+    #[inline(always)]
+    fn t_max(&self) -> f32 {
+        self.t_max
+    }
+
+    #[inline(always)]
+    fn leaf(&mut self, blocks: &[Triangle4], _count: u32) -> bool {
+        // A plain loop: `Iterator::any` here was left out of line.
+        for block in blocks {
+            if block.any_hit(&self.ray, self.t_max) {
+                return true;
+            }
+        }
+        false
+    }
+}
+
+/// The all-hit count: every triangle hit on the segment, no early exit and no pruning.
+pub struct HitCount {
+    ray: RayTri4,
+    t_max: f32,
+    /// Triangles hit so far.
+    pub hits: u32,
+}
+
+impl HitCount {
+    /// A count along `ray`, at zero.
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> Self {
+        Self {
+            ray: RayTri4::new(ray),
+            t_max: ray.t_max,
+            hits: 0,
+        }
+    }
+}
+
+impl LeafVisitor for HitCount {
+    const ORDERED: bool = false;
+
+    #[inline(always)]
+    fn t_max(&self) -> f32 {
+        self.t_max
+    }
+
+    #[inline(always)]
+    fn leaf(&mut self, blocks: &[Triangle4], _count: u32) -> bool {
+        for block in blocks {
+            self.hits += block.intersect(&self.ray, self.t_max).mask.count_ones();
+        }
+        false
+    }
+}
+
+impl<const W: usize> WideBvhN<W>
+where
+    Width<W>: Lanes<W>,
+{
+    /// The one wide traversal: every node whose box the segment up to `visitor.t_max()` touches,
+    /// nearest first when the visitor is ordered, with `visitor` called at each leaf until it
+    /// returns true (then this returns true). Closest hit, any hit and the all-hit count are
+    /// visitors over it; so can a caller's own leaf test be.
+    pub fn traverse<V: LeafVisitor>(&self, ray: &Ray, visitor: &mut V) -> bool {
+        if self.nodes.is_empty() || self.misses_root(ray) {
+            return false;
+        }
+        self.walk(0, ray, visitor, &mut ())
+    }
+
+    /// [`WideBvh::traverse`], adding what it did to `stats` (see
+    /// [`WideBvh::closest_hit_with_stats`] for what counts).
+    pub fn traverse_with_stats<V: LeafVisitor>(
+        &self,
+        ray: &Ray,
+        visitor: &mut V,
+        stats: &mut TraversalStats,
+    ) -> bool {
+        if self.nodes.is_empty() || self.misses_root(ray) {
+            return false;
+        }
+        self.walk(0, ray, visitor, stats)
+    }
+
     /// The closest hit on `[ray.t_min, ray.t_max]`, exactly as the binary BVH and brute force
     /// find it over the triangles the tree was collapsed with.
     pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
@@ -133,9 +469,6 @@ impl WideBvh {
     /// [`WideBvh::closest_hit`], adding what it did to `stats` (a wide node counts as one inner
     /// node, a leaf's triangles as tested whatever their lanes decide; a ray that passes the
     /// root's box by visits none: see `WideBvh::misses_root`).
-    ///
-    /// The loop keeps the node it is in rather than pushing and popping it: a node with one child
-    /// hit goes straight on to it, and one with several pushes all but the nearest, farthest first.
     pub fn closest_hit_with_stats(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
         self.closest(ray, stats)
     }
@@ -184,115 +517,9 @@ impl WideBvh {
     /// pending entries) is set up only for rays that get past [`WideBvh::misses_root`].
     #[inline(never)]
     fn closest_from_root(&self, ray: &Ray, stats: &mut impl Counters) -> Option<Hit> {
-        let r = Ray4::new(ray);
-        let rt = RayTri4::new(ray);
-        let mut best: Option<Hit> = None;
-        // The segment's end: the closest hit so far, else `ray.t_max`.
-        let mut t_max = ray.t_max;
-        let mut stack: Stack<Entry, WIDE_STACK> = Stack::new();
-        let (mut child, mut count) = (0u32, 0u32);
-        loop {
-            if count == 0 {
-                stats.node();
-                let node = &self.nodes[child as usize];
-                let (t_near, mask) = r.intersect(node, t_max);
-                if mask != 0 {
-                    let first = mask.trailing_zeros() as usize;
-                    if mask & (mask - 1) == 0 {
-                        child = node.child[first];
-                        count = node.count[first];
-                        continue;
-                    }
-                    let t_near = t_near.to_array();
-                    let rest = mask & (mask - 1);
-                    let second = rest.trailing_zeros() as usize;
-                    let (near, far) = if t_near[second] < t_near[first] {
-                        (second, first)
-                    } else {
-                        (first, second)
-                    };
-                    let nearest = if rest & (rest - 1) == 0 {
-                        // Two children hit, the commonest case after one: push the farther.
-                        stack.push((node.child[far], node.count[far], t_near[far]));
-                        near
-                    } else {
-                        // Three or four: sorted by entry, nearest last.
-                        let mut hits =
-                            [(far, t_near[far]), (near, t_near[near]), (0, 0.0), (0, 0.0)];
-                        let mut n = 2;
-                        let mut m = rest & (rest - 1);
-                        while m != 0 {
-                            let i = m.trailing_zeros() as usize;
-                            m &= m - 1;
-                            let mut j = n;
-                            while j > 0 && hits[j - 1].1 < t_near[i] {
-                                hits[j] = hits[j - 1];
-                                j -= 1;
-                            }
-                            hits[j] = (i, t_near[i]);
-                            n += 1;
-                        }
-                        for &(i, t) in &hits[..n - 1] {
-                            stack.push((node.child[i], node.count[i], t));
-                        }
-                        hits[n - 1].0
-                    };
-                    child = node.child[nearest];
-                    count = node.count[nearest];
-                    continue;
-                }
-            } else {
-                self.leaf_closest(child, count, &rt, &mut best, &mut t_max, stats);
-            }
-            // Pop the next subtree that can still hold a closer hit: the same padded bound the box
-            // test used when it admitted the subtree.
-            loop {
-                let Some((c, n, t_entry)) = stack.pop() else {
-                    return best;
-                };
-                if t_entry <= pad_far(t_max) {
-                    child = c;
-                    count = n;
-                    break;
-                }
-            }
-        }
-    }
-
-    /// Tests the `count` triangles of the leaf whose blocks start at `first`, keeping the closest
-    /// hit in `best` and its distance in `t_max`. Every lane hit in a block lies within the
-    /// segment as it was before the block, so the closest of them under the tie rule, compared
-    /// with `best`, is what the scalar loop (which shortens the segment after each hit) finds.
-    #[inline(always)]
-    fn leaf_closest(
-        &self,
-        first: u32,
-        count: u32,
-        ray: &RayTri4,
-        best: &mut Option<Hit>,
-        t_max: &mut f32,
-        stats: &mut impl Counters,
-    ) {
-        stats.leaf(count);
-        let first = first as usize;
-        for block in &self.tris[first..first + count.div_ceil(4) as usize] {
-            let h = block.intersect(ray, *t_max);
-            let mut m = h.mask;
-            while m != 0 {
-                let j = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let hit = Hit {
-                    t: h.t[j],
-                    triangle: block.id[j],
-                    u: h.u[j],
-                    v: h.v[j],
-                };
-                if best.is_none_or(|b| hit.is_closer_than(&b)) {
-                    *best = Some(hit);
-                    *t_max = hit.t;
-                }
-            }
-        }
+        let mut visitor = ClosestHit::new(ray);
+        self.walk(0, ray, &mut visitor, stats);
+        visitor.best
     }
 
     /// True when any triangle is hit on the segment; stops at the first hit.
@@ -324,44 +551,167 @@ impl WideBvh {
     /// [`WideBvh::closest_from_root`]).
     #[inline(never)]
     fn any_from_root(&self, root: u32, ray: &Ray, stats: &mut impl Counters) -> bool {
-        let r = Ray4::new(ray);
-        let rt = RayTri4::new(ray);
-        let mut stack: Stack<(u32, u32), WIDE_STACK> = Stack::new();
+        self.walk(root, ray, &mut AnyHit::new(ray), stats)
+    }
+
+    /// The all-hit walk: every wide node whose box the segment touches (`inner_nodes`), every
+    /// leaf and triangle in those boxes, and how many of those triangles the segment hits, with
+    /// no early exit. The 4-wide counterpart of [`crate::bvh::Bvh::all_hit`].
+    pub fn all_hit(&self, ray: &Ray) -> AllHitStats {
+        let mut count = HitCount::new(ray);
+        let mut stats = TraversalStats::default();
+        self.traverse_with_stats(ray, &mut count, &mut stats);
+        AllHitStats {
+            inner_nodes: stats.inner_nodes,
+            leaves: stats.leaves,
+            triangles: stats.triangles,
+            hits: count.hits,
+        }
+    }
+
+    /// The loop every query shares, from node `root` (the root box test done or skipped by the
+    /// caller). It keeps the node it is in rather than pushing and popping it: a node with one
+    /// child hit goes straight on to it, and one with several pushes all but the one it goes to
+    /// (for an ordered visitor the nearest, the rest pushed farthest first).
+    #[inline(always)]
+    fn walk<V: LeafVisitor>(
+        &self,
+        root: u32,
+        ray: &Ray,
+        visitor: &mut V,
+        stats: &mut impl Counters,
+    ) -> bool {
+        let r = RayN::<<Width<W> as Lanes<W>>::V>::new(ray);
+        let mut stack = <<Width<W> as Lanes<W>>::Pending as Pending>::new();
         let (mut child, mut count) = (root, 0u32);
         loop {
             if count == 0 {
                 stats.node();
                 let node = &self.nodes[child as usize];
-                let (_, mut mask) = r.intersect(node, ray.t_max);
+                let (t_near, mask) = r.intersect(node, visitor.t_max());
                 if mask != 0 {
-                    // Any hit needs no order: go on to the first child hit, push the others.
                     let first = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    while mask != 0 {
-                        let i = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        stack.push((node.child[i], node.count[i]));
-                    }
-                    child = node.child[first];
-                    count = node.count[first];
+                    let rest = mask & (mask - 1);
+                    let next = if rest == 0 {
+                        first
+                    } else {
+                        // Several children hit: start fetching them all now, so their cache
+                        // misses overlap the work on the first (the loop is bound by them).
+                        self.prefetch(node, mask);
+                        if V::ORDERED {
+                            push_ordered(&mut stack, node, t_near, first, rest)
+                        } else {
+                            let mut m = rest;
+                            while m != 0 {
+                                let i = m.trailing_zeros() as usize;
+                                m &= m - 1;
+                                stack.push((node.child[i], node.count[i], 0.0));
+                            }
+                            first
+                        }
+                    };
+                    child = node.child[next];
+                    count = node.count[next];
                     continue;
                 }
             } else {
                 stats.leaf(count);
                 let first = child as usize;
-                for block in &self.tris[first..first + count.div_ceil(4) as usize] {
-                    if block.any_hit(&rt, ray.t_max) {
-                        return true;
-                    }
+                let blocks = &self.tris[first..first + count.div_ceil(4) as usize];
+                if visitor.leaf(blocks, count) {
+                    return true;
                 }
             }
-            let Some((c, n)) = stack.pop() else {
-                return false;
-            };
-            child = c;
-            count = n;
+            // Pop the next subtree that can still hold a closer hit: the same padded bound the
+            // box test used when it admitted the subtree.
+            loop {
+                let Some((c, n, t_entry)) = stack.pop() else {
+                    return false;
+                };
+                if !V::ORDERED || t_entry <= pad_far(visitor.t_max()) {
+                    child = c;
+                    count = n;
+                    break;
+                }
+            }
         }
     }
+}
+
+impl<const W: usize> WideBvhN<W> {
+    /// Hints the cache to fetch the children in `mask`: a node's two lines, or a leaf's first
+    /// block's three. A hint only: no fault, no effect on any answer.
+    #[inline(always)]
+    fn prefetch(&self, node: &WideNodeN<W>, mask: u32) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use core::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let mut m = mask;
+            while m != 0 {
+                let i = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let (child, count) = (node.child[i] as usize, node.count[i]);
+                // `wrapping_add`: the address is only a hint, never dereferenced here.
+                let (p, lines) = if count == 0 {
+                    (self.nodes.as_ptr().wrapping_add(child).cast::<i8>(), 2)
+                } else {
+                    (self.tris.as_ptr().wrapping_add(child).cast::<i8>(), 3)
+                };
+                for l in 0..lines {
+                    // SAFETY: prefetching is a hint with no memory access semantics; any
+                    // address is allowed.
+                    unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64 * l)) };
+                }
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = (node, mask);
+    }
+}
+
+/// Pushes the children hit in `first` and `rest` (a mask of at least one more) but the nearest,
+/// farthest first, and returns the nearest.
+#[inline(always)]
+fn push_ordered<const W: usize, V: ChildLanes<W>>(
+    stack: &mut impl Pending,
+    node: &WideNodeN<W>,
+    t_near: V,
+    first: usize,
+    rest: u32,
+) -> usize {
+    let t_near = t_near.to_array();
+    let second = rest.trailing_zeros() as usize;
+    let (near, far) = if t_near[second] < t_near[first] {
+        (second, first)
+    } else {
+        (first, second)
+    };
+    if rest & (rest - 1) == 0 {
+        // Two children hit, the commonest case after one: push the farther.
+        stack.push((node.child[far], node.count[far], t_near[far]));
+        return near;
+    }
+    // Three or more: sorted by entry, nearest last.
+    let mut hits = [(0, 0.0); W];
+    hits[0] = (far, t_near[far]);
+    hits[1] = (near, t_near[near]);
+    let mut n = 2;
+    let mut m = rest & (rest - 1);
+    while m != 0 {
+        let i = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let mut j = n;
+        while j > 0 && hits[j - 1].1 < t_near[i] {
+            hits[j] = hits[j - 1];
+            j -= 1;
+        }
+        hits[j] = (i, t_near[i]);
+        n += 1;
+    }
+    for &(i, t) in &hits[..n - 1] {
+        stack.push((node.child[i], node.count[i], t));
+    }
+    hits[n - 1].0
 }
 
 #[cfg(test)]
@@ -372,7 +722,7 @@ mod tests {
     use super::*;
     use crate::brute_force;
     use crate::builder::Builder;
-    use crate::bvh::Bvh;
+    use crate::bvh::{Bvh, WideBvh};
     use crate::geometry::Triangle;
     use crate::random::Pcg32;
 
@@ -391,7 +741,9 @@ mod tests {
             let tris = &tris[..n];
             let bvh = Builder::sah().build(tris).unwrap();
             let wide = WideBvh::from_binary(&bvh, tris);
+            let wide8 = crate::bvh::WideBvh8::from_binary(&bvh, tris);
             assert!(wide.max_depth() <= bvh.max_depth());
+            assert!(wide8.max_depth() <= wide.max_depth());
             for i in 0..2000 {
                 let o = v(12.0);
                 let mut d = v(1.0);
@@ -405,12 +757,17 @@ mod tests {
                         continue;
                     };
                     assert_eq!(wide.closest_hit(&r), brute_force::closest_hit(&r, tris));
+                    assert_eq!(wide8.closest_hit(&r), brute_force::closest_hit(&r, tris));
                     continue;
                 }
                 let Ok(r) = Ray::new(o, d) else { continue };
                 let expect = brute_force::closest_hit(&r, tris);
                 assert_eq!(wide.closest_hit(&r), expect, "ray {i}");
                 assert_eq!(wide.any_hit(&r), expect.is_some());
+                assert_eq!(wide.all_hit(&r).hits, brute_force::hit_count(&r, tris));
+                assert_eq!(wide8.closest_hit(&r), expect, "ray {i}");
+                assert_eq!(wide8.any_hit(&r), expect.is_some());
+                assert_eq!(wide8.all_hit(&r).hits, brute_force::hit_count(&r, tris));
             }
         }
     }

@@ -374,7 +374,7 @@ impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
                 t_max: t_exit.min(ray.t_max),
                 ..*ray
             };
-            if let Some(hit) = log.local_closest(&self.local[a as usize], &segment, tris) {
+            if let Some(hit) = log.closest(&self.local[a as usize], &segment, tris, true) {
                 log.answered_by(a);
                 return Some(hit);
             }
@@ -384,7 +384,7 @@ impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
             t_min: searched_to,
             ..*ray
         };
-        log.fallback_closest(&self.fallback, &rest, tris)
+        log.closest(&self.fallback, &rest, tris, false)
     }
 
     /// The any-hit query, recording into `log`.
@@ -396,7 +396,7 @@ impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
                 t_max: t_exit.min(ray.t_max),
                 ..*ray
             };
-            if log.local_any(&self.local[a as usize], &segment, tris) {
+            if log.any(&self.local[a as usize], &segment, tris, true) {
                 log.answered_by(a);
                 return true;
             }
@@ -406,7 +406,7 @@ impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
             t_min: searched_to,
             ..*ray
         };
-        log.fallback_any(&self.fallback, &rest, tris)
+        log.any(&self.fallback, &rest, tris, false)
     }
 
     /// The break-even measurement for area `area` over `rays`: its local hit rate, the local and
@@ -459,81 +459,64 @@ impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
 
 /// Where a scene query records what it did: [`TopLevelStats`], or `()` for nothing.
 trait QueryLog {
-    /// The local tree's closest hit on `ray`, one affine area tried.
-    fn local_closest<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle])
-        -> Option<Hit>;
-    /// The local tree's any hit on `ray`, one affine area tried.
-    fn local_any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle]) -> bool;
-    /// The fallback tree's closest hit on the rest of the segment.
-    fn fallback_closest<T: Traversable>(
+    /// A tree's closest hit on `ray`: an affine area's local tree (`local`) or the fallback's.
+    fn closest<T: Traversable>(
         &mut self,
         t: &T,
         ray: &Ray,
         tris: &[Triangle],
+        local: bool,
     ) -> Option<Hit>;
-    /// The fallback tree's any hit on the rest of the segment.
-    fn fallback_any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle]) -> bool;
+    /// A tree's any hit on `ray`, as [`QueryLog::closest`].
+    fn any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle], local: bool) -> bool;
     /// Area `area`'s local tree answered.
     fn answered_by(&mut self, area: u32);
 }
 
 impl QueryLog for () {
     #[inline(always)]
-    fn local_closest<T: Traversable>(
+    fn closest<T: Traversable>(
         &mut self,
         t: &T,
         ray: &Ray,
         tris: &[Triangle],
+        _: bool,
     ) -> Option<Hit> {
         t.closest_hit(ray, tris)
     }
     #[inline(always)]
-    fn local_any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle]) -> bool {
-        t.any_hit(ray, tris)
-    }
-    #[inline(always)]
-    fn fallback_closest<T: Traversable>(
-        &mut self,
-        t: &T,
-        ray: &Ray,
-        tris: &[Triangle],
-    ) -> Option<Hit> {
-        t.closest_hit(ray, tris)
-    }
-    #[inline(always)]
-    fn fallback_any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle]) -> bool {
+    fn any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle], _: bool) -> bool {
         t.any_hit(ray, tris)
     }
     #[inline(always)]
     fn answered_by(&mut self, _: u32) {}
 }
 
+impl TopLevelStats {
+    /// The counters of a local tree's try, or of the fallback, noting which.
+    fn tree(&mut self, local: bool) -> &mut TraversalStats {
+        if local {
+            self.tries += 1;
+            &mut self.local
+        } else {
+            self.fell_back = true;
+            &mut self.fallback
+        }
+    }
+}
+
 impl QueryLog for TopLevelStats {
-    fn local_closest<T: Traversable>(
+    fn closest<T: Traversable>(
         &mut self,
         t: &T,
         ray: &Ray,
         tris: &[Triangle],
+        local: bool,
     ) -> Option<Hit> {
-        self.tries += 1;
-        t.closest_hit_with_stats(ray, tris, &mut self.local)
+        t.closest_hit_with_stats(ray, tris, self.tree(local))
     }
-    fn local_any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle]) -> bool {
-        self.tries += 1;
-        t.any_hit_with_stats(ray, tris, &mut self.local)
-    }
-    fn fallback_closest<T: Traversable>(
-        &mut self,
-        t: &T,
-        ray: &Ray,
-        tris: &[Triangle],
-    ) -> Option<Hit> {
-        self.fell_back = true;
-        t.closest_hit_with_stats(ray, tris, &mut self.fallback)
-    }
-    fn fallback_any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle]) -> bool {
-        self.fell_back = true;
-        t.any_hit_with_stats(ray, tris, &mut self.fallback)
+    fn any<T: Traversable>(&mut self, t: &T, ray: &Ray, tris: &[Triangle], local: bool) -> bool {
+        t.any_hit_with_stats(ray, tris, self.tree(local))
     }
     fn answered_by(&mut self, area: u32) {
         self.answered_by = Some(area);

@@ -6,7 +6,7 @@ use super::{Bvh, Hit, Lanes, TraversalStats, WideBvhN, Width};
 use crate::geometry::{Ray, Triangle, Triangle4};
 
 /// Closest-hit and any-hit queries over the triangles a hierarchy was built from, with the work
-/// counted, and its size. Implemented by [`Bvh`] and [`WideBvh`]; both answer exactly as brute
+/// counted, and its size. Implemented by [`Bvh`] and [`super::WideBvh`] (and `WideBvh8`); both answer exactly as brute
 /// force does, so a scene answers the same with either.
 pub trait Traversable {
     /// The closest hit on `[ray.t_min, ray.t_max]`, adding the work to `stats`.

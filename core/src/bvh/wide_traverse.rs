@@ -1,4 +1,4 @@
-//! Traversal of 4-wide BVHs: one loop ([`WideBvh::traverse`]) with one 4-wide slab test per node,
+//! Traversal of 4-wide BVHs: one loop ([`super::WideBvh::traverse`]) with one 4-wide slab test per node,
 //! and a leaf callback ([`LeafVisitor`]) that makes it closest hit, any hit or the all-hit count.
 
 use core::ops::{Add, Mul, Sub};
@@ -97,7 +97,7 @@ impl ChildLanes<4> for f32x4 {
 
 /// With AVX one 8-lane instruction per step, else two 4-lane halves (`wide` picks at compile
 /// time); `fast_max`/`fast_min` keep the accumulator on NaN either way (`maxps`, `vmaxps` and the
-/// halves' [`keep_max`] all return their second operand then).
+/// halves' `keep_max` all return their second operand then).
 impl ChildLanes<8> for f32x8 {
     #[inline(always)]
     fn splat(v: f32) -> Self {
@@ -284,7 +284,7 @@ impl Counters for () {
     fn leaf(&mut self, _: u32) {}
 }
 
-/// The leaf callback of the one 4-wide traversal ([`WideBvh::traverse`]): closest hit, any hit
+/// The leaf callback of the one 4-wide traversal ([`super::WideBvh::traverse`]): closest hit, any hit
 /// and the all-hit count are each a visitor over the same loop, which is monomorphised per
 /// visitor, so each query compiles to its own loop with nothing of the others in it.
 pub trait LeafVisitor {
@@ -446,8 +446,8 @@ where
         self.walk(0, ray, visitor, &mut ())
     }
 
-    /// [`WideBvh::traverse`], adding what it did to `stats` (see
-    /// [`WideBvh::closest_hit_with_stats`] for what counts).
+    /// [`super::WideBvh::traverse`], adding what it did to `stats` (see
+    /// [`super::WideBvh::closest_hit_with_stats`] for what counts).
     pub fn traverse_with_stats<V: LeafVisitor>(
         &self,
         ray: &Ray,
@@ -466,7 +466,7 @@ where
         self.closest(ray, &mut ())
     }
 
-    /// [`WideBvh::closest_hit`], adding what it did to `stats` (a wide node counts as one inner
+    /// [`super::WideBvh::closest_hit`], adding what it did to `stats` (a wide node counts as one inner
     /// node, a leaf's triangles as tested whatever their lanes decide; a ray that passes the
     /// root's box by visits none: see `WideBvh::misses_root`).
     pub fn closest_hit_with_stats(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
@@ -527,7 +527,7 @@ where
         self.any(ray, &mut ())
     }
 
-    /// [`WideBvh::any_hit`], adding what it did to `stats`.
+    /// [`super::WideBvh::any_hit`], adding what it did to `stats`.
     pub fn any_hit_with_stats(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
         self.any(ray, stats)
     }

@@ -138,7 +138,7 @@ section "miri (rdbvh-core unit tests: geometry, simd, traversal stacks, graft)"
 if [[ ${MIRI:-1} != 0 ]] && rustup run nightly rustc --version >/dev/null 2>&1 \
     && rustup component add miri rust-src --toolchain nightly >/dev/null 2>&1; then
     cargo +nightly miri test -p rdbvh-core --lib --target s390x-unknown-linux-gnu \
-        -- geometry:: simd:: bvh::traverse:: build::graft::tests::small_ 2>&1 \
+        -- geometry:: simd:: bvh::traverse:: builder::graft::tests::small_ 2>&1 \
         | tee "$LOG_DIR/miri.log"
 else
     echo "miri skipped: no nightly toolchain with the miri component here (MIRI=${MIRI:-1})"

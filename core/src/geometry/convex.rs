@@ -322,9 +322,11 @@ mod tests {
         ];
         let mut rng = Pcg32::new(17);
         let mut v = |s: f32| Vec3::new(rng.range(-s, s), rng.range(-s, s), rng.range(-s, s));
+        // Miri interprets every instruction: a few hundred rays a shape there.
+        let rays = if cfg!(miri) { 300 } else { 20_000 };
         let mut inside = 0;
         for shape in &shapes {
-            for i in 0..20_000 {
+            for i in 0..rays {
                 // Axis-parallel directions (zero components) and origins on faces included.
                 let mut dir = v(1.0);
                 if i % 7 == 0 {
@@ -349,7 +351,7 @@ mod tests {
                 inside += usize::from(expected.is_some());
             }
         }
-        assert!(inside > 5_000, "{inside}");
+        assert!(inside > rays / 4, "{inside}");
     }
 
     #[test]

@@ -1,0 +1,205 @@
+//! The renderer's shadow rays through the three `rdbvh render --structure` choices, on the scenes
+//! and lights of `scripts/render-comparison.sh` at a smaller frame (128 x 128, 2 samples, 3
+//! bounces, seed 1):
+//!
+//! - `render/SCENE/shadow/{global,lights,thesis}`: the frame's shadow segments answered on one
+//!   thread, as `shadow_ms` replays them (throughput in segments);
+//! - `render/SCENE/build/{global,lights,thesis}`: building the structure, the `lights` pilot
+//!   frame included (two threads).
+//!
+//! Untimed, printed before each group: each structure's node + triangle tests per shadow segment
+//! (the machine-independent measure), and a check that it answers every segment as the frame did.
+//! The room is built in; the other scenes need `../shared/scenes` and are skipped without it.
+
+use std::hint::black_box;
+use std::path::Path;
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use glam::Vec3;
+use rdbvh::render::{
+    build_lights, emissive_lights, parse_lights, pilot_size, render_frame, Camera, FrameSettings,
+    Integrator, LightSet, ShadowRay, Structure, StructureKind, DEFAULT_FOV_DEG,
+};
+use rdbvh::scene::Scene;
+use rdbvh_benches::scenes_dir;
+use rdbvh_core::bvh::TraversalStats;
+
+const SIZE: (u32, u32) = (128, 128);
+const SPP: u32 = 2;
+const BOUNCES: u32 = 3;
+const SEED: u64 = 1;
+
+/// A scene of the comparison: its file (or built-in name), its extra lights and its camera.
+struct Case {
+    name: &'static str,
+    scene: &'static str,
+    lights: &'static str,
+    eye: Option<(Vec3, Vec3, f32)>,
+}
+
+const CASES: [Case; 3] = [
+    Case {
+        name: "room",
+        scene: "builtin:room",
+        lights: "",
+        eye: Some((Vec3::new(5.0, 5.0, 0.3), Vec3::new(5.0, 4.0, 10.0), 75.0)),
+    },
+    Case {
+        name: "cornell_box",
+        scene: "cornell_box",
+        lights: "",
+        eye: None,
+    },
+    Case {
+        name: "sponza_crytek",
+        scene: "sponza_crytek",
+        lights: "[[light]]\nkind = \"point\"\nposition = [0.0, 800.0, 0.0]\n\
+                 intensity = [400000.0, 380000.0, 340000.0]\n",
+        eye: Some((
+            Vec3::new(1100.0, 200.0, -50.0),
+            Vec3::new(-900.0, 400.0, 0.0),
+            60.0,
+        )),
+    },
+];
+
+/// A loaded case: the scene, its lights and where the camera looks from.
+struct Loaded {
+    scene: Scene,
+    lights: LightSet,
+    /// Eye, look-at point and vertical field of view in degrees.
+    view: (Vec3, Vec3, f32),
+}
+
+impl Loaded {
+    fn new(case: &Case) -> Result<Self, String> {
+        let scene = if case.scene.starts_with("builtin:") {
+            Scene::open(case.scene)
+        } else {
+            Scene::load(scenes_dir()?.join(format!("{}.obj", case.scene)))
+        }
+        .map_err(|e| e.to_string())?;
+        let mut lights = emissive_lights(&scene);
+        lights.extend(parse_lights(case.lights, Path::new("bench")).map_err(|e| e.to_string())?);
+        let lights = LightSet::new(lights, &scene.triangles).ok_or("no light")?;
+        let view = match case.eye {
+            Some(view) => view,
+            None => {
+                let framing = Camera::framing(scene.bounds, DEFAULT_FOV_DEG, SIZE.0, SIZE.1)
+                    .map_err(|e| e.to_string())?;
+                (framing.eye(), scene.bounds.center(), DEFAULT_FOV_DEG)
+            }
+        };
+        Ok(Self {
+            scene,
+            lights,
+            view,
+        })
+    }
+
+    /// The camera for an image of `size`.
+    fn camera(&self, (w, h): (u32, u32)) -> Camera {
+        let (eye, at, fov) = self.view;
+        Camera::new(eye, at, Vec3::Y, fov, w, h).expect("a valid camera")
+    }
+
+    /// Builds `kind`, as `rdbvh render` does (the pilot frame for `lights`).
+    fn build(&self, kind: StructureKind) -> Structure {
+        let built = match kind {
+            StructureKind::Lights => {
+                let size = pilot_size(SIZE.0, SIZE.1);
+                let camera = self.camera(size);
+                build_lights(&self.scene, &self.lights, BOUNCES, &camera, size, SEED)
+                    .map(|(s, _)| s)
+            }
+            kind => Structure::build(kind, &self.scene.triangles, self.lights.lights()),
+        };
+        built.expect("the structure builds")
+    }
+
+    /// The frame's shadow segments, rendered through the global BVH.
+    fn shadow_segments(&self) -> Vec<ShadowRay> {
+        let global = self.build(StructureKind::Global);
+        let integrator =
+            Integrator::new(&self.scene, &self.lights, &global, BOUNCES).expect("an integrator");
+        let settings = FrameSettings {
+            width: SIZE.0,
+            height: SIZE.1,
+            spp: SPP,
+            seed: SEED,
+            record_limit: 0,
+            progress: false,
+        };
+        render_frame(&integrator, &self.camera(SIZE), &settings).shadow_rays
+    }
+}
+
+fn render(c: &mut Criterion) {
+    for case in &CASES {
+        let loaded = match Loaded::new(case) {
+            Ok(x) => x,
+            Err(e) => {
+                eprintln!("render benchmarks skipped for {}: {e}", case.name);
+                continue;
+            }
+        };
+        let shadow = loaded.shadow_segments();
+        let kinds = [
+            StructureKind::Global,
+            StructureKind::Lights,
+            StructureKind::Thesis,
+        ];
+        let structures: Vec<Structure> = kinds.iter().map(|&k| loaded.build(k)).collect();
+        let mut group = c.benchmark_group(format!("render/{}/shadow", case.name));
+        group
+            .throughput(Throughput::Elements(shadow.len() as u64))
+            .sample_size(10)
+            .warm_up_time(Duration::from_millis(300))
+            .measurement_time(Duration::from_secs(2));
+        for (kind, structure) in kinds.iter().zip(&structures) {
+            let mut stats = TraversalStats::default();
+            for s in &shadow {
+                let blocked = structure.occluded_counted(s.light as usize, &s.ray, &mut stats);
+                assert_eq!(
+                    blocked,
+                    s.occluded,
+                    "{} answers as the frame did",
+                    kind.name()
+                );
+            }
+            let n = shadow.len().max(1) as f64;
+            eprintln!(
+                "render/{}/shadow/{}: {} segments, {:.2} nodes + {:.2} triangles a segment",
+                case.name,
+                kind.name(),
+                shadow.len(),
+                f64::from(stats.inner_nodes) / n,
+                f64::from(stats.triangles) / n
+            );
+            group.bench_function(kind.name(), |b| {
+                b.iter(|| {
+                    black_box(&shadow)
+                        .iter()
+                        .filter(|s| structure.occluded(s.light as usize, &s.ray))
+                        .count()
+                })
+            });
+        }
+        group.finish();
+        let mut group = c.benchmark_group(format!("render/{}/build", case.name));
+        group
+            .sample_size(10)
+            .warm_up_time(Duration::from_millis(300))
+            .measurement_time(Duration::from_secs(3));
+        for kind in kinds {
+            group.bench_function(kind.name(), |b| {
+                b.iter(|| black_box(&loaded).build(kind).build_ms())
+            });
+        }
+        group.finish();
+    }
+}
+
+criterion_group!(benches, render);
+criterion_main!(benches);

@@ -211,7 +211,7 @@ pub struct RdbvhWide8;
 impl Library for RdbvhWide8 {
     const NAME: &'static str = "rdbvh-wide8";
     const PARALLEL_BUILD: Option<&'static str> =
-        Some("rdbvh::parallel::build, then the single-threaded reinsertion and 8-wide collapse");
+        Some("rdbvh_core::builder::parallel::build, then the single-threaded reinsertion and 8-wide collapse");
     type Scene = Vec<Triangle>;
     type Ray = Ray;
     type Accel = rdbvh_core::bvh::WideBvh8;

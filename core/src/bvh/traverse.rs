@@ -167,8 +167,12 @@ trait LeafQuery {
     const ORDERED: bool;
     /// Where the segment effectively ends now: child boxes are tested up to here.
     fn t_max(&self) -> f32;
-    /// True when a subtree entered at `t_entry` may still hold what the query wants.
-    fn wants(&self, t_entry: f32) -> bool;
+    /// True when a subtree entered at `t_entry` may still hold what the query wants: always,
+    /// for a query that does not shorten the segment.
+    #[inline(always)]
+    fn wants(&self, _t_entry: f32) -> bool {
+        true
+    }
     /// Tests a leaf's primitives; `true` ends the traversal.
     fn leaf(&mut self, ids: &[u32]) -> bool;
     /// An inner node was visited (both child boxes tested).
@@ -219,10 +223,6 @@ impl LeafQuery for Any<'_> {
         self.ray.t_max
     }
     #[inline(always)]
-    fn wants(&self, _: f32) -> bool {
-        true
-    }
-    #[inline(always)]
     fn leaf(&mut self, ids: &[u32]) -> bool {
         any_prim(ids, self.ray, self.tris, self.stats)
     }
@@ -244,10 +244,6 @@ impl LeafQuery for AllHit<'_> {
     #[inline(always)]
     fn t_max(&self) -> f32 {
         self.ray.t_max
-    }
-    #[inline(always)]
-    fn wants(&self, _: f32) -> bool {
-        true
     }
     #[inline(always)]
     fn leaf(&mut self, ids: &[u32]) -> bool {

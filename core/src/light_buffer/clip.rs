@@ -14,6 +14,12 @@ const MAX_PLANES: usize = 5;
 /// bends the polygon (the clip then stops early with a box that is only larger).
 const MAX_CLIPPED: usize = 16;
 
+/// A triangle's vertices in f64, where every decision of the build is made.
+#[inline]
+pub(crate) fn vertices_f64(tri: &Triangle) -> [DVec3; 3] {
+    [tri.v0, tri.v1, tri.v2].map(Vec3::as_dvec3)
+}
+
 /// Where a triangle lies against a region ([`Region::side`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Side {
@@ -73,25 +79,35 @@ impl Region {
         }
     }
 
+    /// False when all of `verts` lie outside plane `plane` (index into the planes as
+    /// [`Region::new`] orders them: the cell's four sides as `CellRect::side_normals` gives them,
+    /// then the front).
+    #[inline]
+    pub fn reaches_plane(&self, plane: usize, verts: &[DVec3; 3]) -> bool {
+        let (n, c) = self.planes[plane];
+        verts.iter().any(|v| n.dot(*v) >= c)
+    }
+
     /// True unless [`Region::side`] proves `tri` outside: a triangle that might reach the region
     /// (one that misses it near a corner costs a little time, never an answer).
     #[inline]
     pub fn may_reach(&self, tri: &Triangle) -> bool {
-        self.side(&[tri.v0, tri.v1, tri.v2].map(Vec3::as_dvec3)) != Side::Outside
+        self.side(&vertices_f64(tri)) != Side::Outside
     }
 
     /// The box of the part of `tri` inside the region, grown by the margin and kept within the
     /// triangle's own box; `None` when no part of it is inside.
     pub fn clipped_bounds(&self, tri: &Triangle) -> Option<Aabb> {
-        let verts = [tri.v0, tri.v1, tri.v2].map(Vec3::as_dvec3);
+        let verts = vertices_f64(tri);
         match self.side(&verts) {
             Side::Outside => return None,
             Side::Inside => return Some(tri.bounds()),
             Side::Straddles => {}
         }
         let planes = &self.planes[..self.count];
-        let mut poly = [DVec3::ZERO; MAX_CLIPPED];
-        let mut next = [DVec3::ZERO; MAX_CLIPPED];
+        // Two buffers in turn: each plane clips `poly` into `next`, then they swap roles.
+        let mut buffers = [[DVec3::ZERO; MAX_CLIPPED]; 2];
+        let [mut poly, mut next] = buffers.each_mut();
         poly[..3].copy_from_slice(&verts);
         let mut len = 3;
         for &(n, c) in planes {
@@ -116,7 +132,7 @@ impl Region {
                 return None;
             }
             len = out;
-            poly[..len].copy_from_slice(&next[..len]);
+            core::mem::swap(&mut poly, &mut next);
         }
         let (mut lo, mut hi) = (poly[0], poly[0]);
         for &p in &poly[1..len] {

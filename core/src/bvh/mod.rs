@@ -16,6 +16,7 @@ pub use traversable::Traversable;
 pub use traverse::{AllHitStats, Hit, TraversalStats};
 pub use validate::InvariantError;
 pub use wide::{WideBvh, WideBvh8, WideBvhN, WideNode, WideNode8, WideNodeN};
+pub(crate) use wide_traverse::Counters;
 pub use wide_traverse::{AnyHit, ChildLanes, ClosestHit, HitCount, Lanes, LeafVisitor, Width};
 
 use crate::geometry::Aabb;

@@ -543,7 +543,7 @@ where
     /// [`WideBvh::any_hit_with_stats`] from node `root` of a forest ([`WideBvh::append`]), with no
     /// root-box test: a tree the caller chose for the ray.
     #[inline]
-    pub(crate) fn any_hit_from(&self, root: u32, ray: &Ray, stats: &mut TraversalStats) -> bool {
+    pub(crate) fn any_hit_from(&self, root: u32, ray: &Ray, stats: &mut impl Counters) -> bool {
         self.any_from_root(root, ray, stats)
     }
 

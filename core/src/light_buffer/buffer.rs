@@ -3,10 +3,12 @@
 
 use alloc::vec::Vec;
 
+use wide::f32x4;
+
 use super::cell::{face_coords, FACES};
 use super::source::LightSource;
 use super::subdivide::LightBufferBuilder;
-use crate::bvh::{TraversalStats, WideBvh};
+use crate::bvh::{Counters, TraversalStats, WideBvh};
 use crate::geometry::{Ray, Triangle};
 use crate::BuildError;
 
@@ -94,6 +96,8 @@ pub struct LightBuffer {
     pub(crate) forest: WideBvh,
     /// The length margin of every decision ([`super::source::MARGIN`] times the coordinate scale).
     pub(crate) margin: f32,
+    /// Where the segments the buffer answers end ([`LightSource::end_box`]).
+    pub(crate) end_box: (f32x4, f32x4),
     pub(crate) stats: LightBufferStats,
 }
 
@@ -131,7 +135,7 @@ impl LightBuffer {
     /// [`LightBuffer::occluded_with_stats`] without counting.
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> Option<bool> {
-        self.occluded_with_stats(ray, &mut TraversalStats::default())
+        self.query(ray, &mut ())
     }
 
     /// Whether a triangle blocks the shadow segment `ray` (any hit on `[t_min, t_max]`), exactly
@@ -143,11 +147,17 @@ impl LightBuffer {
     /// test), the cell's tree as a [`WideBvh`] traversal does.
     #[inline]
     pub fn occluded_with_stats(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<bool> {
-        if !self.source.accepts(ray, self.margin) {
+        self.query(ray, stats)
+    }
+
+    /// The query, counting into `stats` or (with `()`) not at all.
+    #[inline(always)]
+    fn query(&self, ray: &Ray, stats: &mut impl Counters) -> Option<bool> {
+        if !self.source.ends_on_light(ray, self.end_box, self.margin) {
             return None;
         }
         let cell = self.cell(-ray.dir);
-        stats.inner_nodes += 1;
+        stats.node();
         match self.grid[cell] {
             DARK => None,
             CLEAR => Some(false),

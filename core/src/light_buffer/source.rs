@@ -6,6 +6,7 @@ use alloc::vec::Vec;
 use core::fmt;
 
 use glam::{DVec3, Vec3};
+use wide::f32x4;
 
 use crate::geometry::{Aabb, Ray};
 
@@ -172,24 +173,32 @@ impl LightSource {
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// True when `ray` is a segment the buffer can answer: it ends on the light (`origin + dir`
-    /// within `margin` of the light's box) and, for a one-sided light, starts in front of it
-    /// (within `margin`), since the cells keep nothing behind the light's plane. A spot's cone
-    /// needs no test here: cells that leave it are dark as a whole, and a dark cell answers
-    /// `None` by itself.
-    #[inline]
-    pub(crate) fn accepts(&self, ray: &Ray, margin: f32) -> bool {
-        let end = ray.origin + ray.dir;
+    /// Where a segment the buffer answers may end: the light's box grown by `margin`, as the
+    /// lower and upper corners in lanes 0 to 2 (lane 3 is 0 in both, as a segment's end has it
+    /// in [`LightSource::ends_on_light`]).
+    pub(crate) fn end_box(&self, margin: f32) -> (f32x4, f32x4) {
         let (lo, hi) = (self.bounds.min - margin, self.bounds.max + margin);
-        if !(end.cmpge(lo).all() && end.cmple(hi).all()) {
+        (
+            f32x4::from([lo.x, lo.y, lo.z, 0.0]),
+            f32x4::from([hi.x, hi.y, hi.z, 0.0]),
+        )
+    }
+
+    /// True when `ray` is a segment the buffer can answer: it ends on the light (`origin + dir`
+    /// inside `end_box`, from [`LightSource::end_box`]) and, for a one-sided light, starts in
+    /// front of it (within `margin`), since the cells keep nothing behind the light's plane. A
+    /// spot's cone needs no test here: cells that leave it are dark as a whole, and a dark cell
+    /// answers `None` by itself.
+    #[inline(always)]
+    pub(crate) fn ends_on_light(&self, ray: &Ray, (lo, hi): (f32x4, f32x4), margin: f32) -> bool {
+        let (o, d) = (ray.origin, ray.dir);
+        let end = f32x4::from([o.x + d.x, o.y + d.y, o.z + d.z, 0.0]);
+        if !(lo.simd_le(end) & end.simd_le(hi)).all() {
             return false;
         }
-        let o = ray.origin.as_dvec3();
-        if let Some((n, lowest)) = self.front {
-            if n.dot(o) < lowest - f64::from(margin) {
-                return false;
-            }
+        match self.front {
+            Some((n, lowest)) => n.dot(o.as_dvec3()) >= lowest - f64::from(margin),
+            None => true,
         }
-        true
     }
 }

@@ -167,6 +167,7 @@ impl<'a> LightBufferBuilder<'a> {
     ) -> Result<LightBuffer, BuildError> {
         let r = self.resolution as usize;
         let mut out = LightBuffer {
+            end_box: self.source.end_box(self.margin as f32),
             source: self.source,
             resolution: self.resolution,
             grid: vec![DARK; FACES * r * r],

@@ -8,7 +8,7 @@ use wide::f32x4;
 use super::cell::{face_coords, FACES};
 use super::source::LightSource;
 use super::subdivide::LightBufferBuilder;
-use crate::bvh::{Counters, TraversalStats, WideBvh};
+use crate::bvh::{Counters, TraversalStats, WideBvh8};
 use crate::geometry::{Ray, Triangle};
 use crate::BuildError;
 
@@ -93,7 +93,7 @@ pub struct LightBuffer {
     pub(crate) grid: Vec<u32>,
     /// Every cell's tree in one node array and one block array, in the order the quadtree's
     /// depth-first walk made them: neighbouring cells' trees lie side by side in memory.
-    pub(crate) forest: WideBvh,
+    pub(crate) forest: WideBvh8,
     /// The length margin of every decision ([`super::source::MARGIN`] times the coordinate scale).
     pub(crate) margin: f32,
     /// Where the segments the buffer answers end ([`LightSource::end_box`]).
@@ -143,8 +143,8 @@ impl LightBuffer {
     /// (`origin + dir` on its surface, as a renderer's light sample gives) and starts where the
     /// light sends light; `None` for any other, which the caller answers elsewhere.
     ///
-    /// The cell lookup counts as one inner node in `stats` (it costs less than one 4-wide box
-    /// test), the cell's tree as a [`WideBvh`] traversal does.
+    /// The cell lookup counts as one inner node in `stats` (it costs less than one 8-wide box
+    /// test), the cell's tree as a [`WideBvh8`] traversal does.
     #[inline]
     pub fn occluded_with_stats(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<bool> {
         self.query(ray, stats)

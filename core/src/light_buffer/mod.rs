@@ -3,7 +3,7 @@
 //!
 //! A shadow segment of next event estimation ends on its light, so its direction alone (from the
 //! light toward the receiver, `-ray.dir`) tells which part of the scene it can cross. The buffer
-//! bins those directions on a cube map around the light. Each cell keeps a small [`WideBvh`] over
+//! bins those directions on a cube map around the light. Each cell keeps a small [`WideBvh8`] over
 //! the triangles that segments of its directions can reach: the cell's cone swept over the light's
 //! surface (a Minkowski sum, bounded by shifted planes), tested by exact polygon clipping with
 //! conservative margins, and boxed by the clipped part of each triangle, so a triangle crossing
@@ -17,7 +17,7 @@
 //! does not end on the light, or starts where the light sends no light) gets `None`, so that the
 //! caller can ask another structure instead.
 //!
-//! [`WideBvh`]: crate::bvh::WideBvh
+//! [`WideBvh8`]: crate::bvh::WideBvh8
 
 mod buffer;
 mod cell;

@@ -12,7 +12,7 @@ use super::cell::{CellRect, CONE_MARGIN, FACES};
 use super::clip::{vertices_f64, Region};
 use super::source::{LightSource, MARGIN};
 use crate::builder::{BuildArena, Builder};
-use crate::bvh::{Bvh, WideBvh};
+use crate::bvh::{Bvh, WideBvh8};
 use crate::geometry::Triangle;
 use crate::BuildError;
 
@@ -52,7 +52,7 @@ pub struct LightBufferFace {
     face: usize,
     /// The face's `r * r` grid cells, roots indexing `forest`.
     grid: Vec<u32>,
-    forest: WideBvh,
+    forest: WideBvh8,
     stats: LightBufferStats,
 }
 
@@ -110,7 +110,7 @@ impl<'a> LightBufferBuilder<'a> {
         let mut out = LightBufferFace {
             face,
             grid: vec![DARK; r * r],
-            forest: WideBvh::default(),
+            forest: WideBvh8::default(),
             stats: LightBufferStats::default(),
         };
         let rect = CellRect::face(face);
@@ -171,7 +171,7 @@ impl<'a> LightBufferBuilder<'a> {
             source: self.source,
             resolution: self.resolution,
             grid: vec![DARK; FACES * r * r],
-            forest: WideBvh::default(),
+            forest: WideBvh8::default(),
             margin: self.margin as f32,
             stats: LightBufferStats::default(),
         };
@@ -332,7 +332,7 @@ impl Leaf {
             Builder::sah().for_wide().build_into(arena, &mut self.bvh)?;
             out.stats.trees += 1;
             out.stats.references += self.local.len();
-            let tree = WideBvh::from_binary(&self.bvh, &self.local);
+            let tree = WideBvh8::from_binary(&self.bvh, &self.local);
             out.forest.append(&tree).unwrap_or(CLEAR)
         };
         let span = 1u32 << (build.options.max_level - task.level);

@@ -9,7 +9,7 @@
 use std::time::Instant;
 
 use rdbvh_core::builder::{parallel, BuildOptions, Preset};
-use rdbvh_core::bvh::{Hit, TraversalStats, WideBvh};
+use rdbvh_core::bvh::{Hit, TraversalStats, WideBvh8};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::light_buffer::LightBuffer;
 
@@ -20,7 +20,7 @@ use super::{Light, RenderError};
 /// Which structure answers the shadow rays (`--structure`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum StructureKind {
-    /// The global BVH: binned SAH with reinsertion (Bittner et al. 2013), collapsed to 4-wide
+    /// The global BVH: binned SAH with reinsertion (Bittner et al. 2013), collapsed to 8-wide
     /// nodes, the fastest single BVH rdbvh builds for these rays.
     Global,
     /// A light buffer per light (per cluster of emissive triangles), built from the lights
@@ -49,7 +49,7 @@ impl StructureKind {
 #[derive(Clone, Debug)]
 pub struct Structure {
     kind: StructureKind,
-    global: WideBvh,
+    global: WideBvh8,
     buffers: Vec<LightBuffer>,
     /// Per light (index into the renderer's lights), its buffer's index, or `NO_BUFFER`.
     buffer_of: Vec<u32>,
@@ -77,7 +77,7 @@ impl Structure {
             ..BuildOptions::new(Preset::Sah)
         };
         let bvh = options.build(triangles, None)?;
-        let mut global = WideBvh::from_binary(&bvh, triangles);
+        let mut global = WideBvh8::from_binary(&bvh, triangles);
         let (buffers, buffer_of) = match kind {
             StructureKind::Global | StructureKind::Thesis => {
                 (Vec::new(), vec![NO_BUFFER; lights.len()])
@@ -119,7 +119,7 @@ impl Structure {
 
     /// The global BVH.
     #[inline]
-    pub fn global(&self) -> &WideBvh {
+    pub fn global(&self) -> &WideBvh8 {
         match &self.thesis {
             Some(t) => t.fallback(),
             None => &self.global,

@@ -30,7 +30,7 @@
 
 use rayon::prelude::*;
 use rdbvh_core::builder::BuildArena;
-use rdbvh_core::bvh::{TraversalStats, WideBvh};
+use rdbvh_core::bvh::{TraversalStats, WideBvh8};
 use rdbvh_core::geometry::{Aabb, Frame, Ray, Triangle};
 use rdbvh_core::influence::{InfluenceArea, PlaneArea, PointArea, DEFAULT_AFFINITY_DEG};
 use rdbvh_core::toplevel::{
@@ -55,7 +55,7 @@ const REACH_PAD: f32 = 1e-3;
 /// The thesis's structure over the renderer's lights.
 #[derive(Clone, Debug)]
 pub struct ThesisStructure {
-    top: TopLevel<Octree, WideBvh>,
+    top: TopLevel<Octree, WideBvh8>,
     cos_point: f32,
 }
 
@@ -77,7 +77,7 @@ impl ThesisStructure {
     pub fn build(
         triangles: &[Triangle],
         lights: &[Light],
-        global: WideBvh,
+        global: WideBvh8,
     ) -> Result<Self, RenderError> {
         let scene = triangles
             .iter()
@@ -102,7 +102,7 @@ impl ThesisStructure {
                     .load_triangle_subset(triangles, ids)
                     .map_err(|e| fail(e.into()))?;
                 let bvh = options.build_loaded(&mut arena, Some(area)).map_err(fail)?;
-                Ok(Some(WideBvh::from_binary(&bvh, triangles)))
+                Ok(Some(WideBvh8::from_binary(&bvh, triangles)))
             })
             .collect::<Result<Vec<_>, TopLevelError>>()
             .map_err(RenderError::Thesis)?;
@@ -123,7 +123,7 @@ impl ThesisStructure {
     }
 
     /// The fallback BVH (the global BVH).
-    pub fn fallback(&self) -> &WideBvh {
+    pub fn fallback(&self) -> &WideBvh8 {
         self.top.fallback()
     }
 
@@ -373,7 +373,7 @@ mod tests {
                 radiance: Vec3::ONE,
             },
         ];
-        let global = WideBvh::from_binary(&Builder::sah().build(tris).unwrap(), tris);
+        let global = WideBvh8::from_binary(&Builder::sah().build(tris).unwrap(), tris);
         let thesis = ThesisStructure::build(tris, &lights, global.clone()).unwrap();
         let summary = thesis.summary();
         // 6 faces + 1 narrow spot + 6 faces of the wide spot (those seeing the room) + 1 box.

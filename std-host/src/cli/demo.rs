@@ -132,12 +132,30 @@ pub fn run_with(out: &mut impl Write, image: &Path) -> Result<(), CliError> {
 /// The camera of the demo's render: inside the room, looking past the boxes at the back wall.
 const ROOM_CAMERA: [&str; 6] = ["--eye", "5,5,0.3", "--look-at", "5,4,10", "--fov", "75"];
 
+/// A bulb under the room's ceiling, beside its emissive quad: the lights file the demo writes
+/// next to its image (`rdbvh-room-lights.toml` beside `rdbvh-room.png`). The quad is wide next to the room's shadow segments and the pilot frame
+/// builds it no light buffer; the bulb's shadow rays converge on a point, where a buffer pays.
+const ROOM_BULB: &str = "# The demo's bulb, beside the room's emissive ceiling quad.
+[[light]]
+kind = \"point\"
+position = [5.0, 4.5, 5.0]
+intensity = [20.0, 20.0, 20.0]
+";
+
 /// Renders the room with next event estimation through both structures, checks that the images
 /// are byte-identical, writes one, and prints what the shadow rays cost through each.
 fn render_room(out: &mut impl Write, image: &Path) -> Result<(), CliError> {
     let w = |out: &mut dyn Write, text: String| writeln!(out, "{text}").map_err(CliError::Stdout);
     let image_arg = image.to_string_lossy();
-    let mut command = vec!["render", "builtin:room"];
+    let stem = image.file_stem().unwrap_or_default().to_string_lossy();
+    let lights = image.with_file_name(format!("{stem}-lights.toml"));
+    super::inputs::check_output(&lights, &[])?;
+    std::fs::write(&lights, ROOM_BULB).map_err(|source| CliError::Write {
+        path: lights.clone(),
+        source,
+    })?;
+    let lights_arg = lights.to_string_lossy();
+    let mut command = vec!["render", "builtin:room", "--lights", &lights_arg];
     command.extend(ROOM_CAMERA);
     command.extend(["--width", "256", "--height", "256", "--spp", "8"]);
     command.extend(["--out", &image_arg]);

@@ -169,6 +169,8 @@ mod tests {
         let image = std::env::temp_dir().join(format!("rdbvh-demo-{}.png", std::process::id()));
         demo::run_with(&mut out, &image).unwrap();
         assert!(image.is_file());
+        let lights = image.with_file_name(format!("rdbvh-demo-{}-lights.toml", std::process::id()));
+        assert!(lights.is_file(), "the demo's lights file beside its image");
         let text = String::from_utf8(out).unwrap();
         assert!(text.contains("agree with brute force"), "{text}");
     }

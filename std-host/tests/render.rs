@@ -96,6 +96,16 @@ fn images_depend_on_the_seed_alone_whatever_the_threads_and_structure() {
     assert_eq!(lights["structure"], "lights");
     assert_eq!(one["light_buffers"], 0);
     assert!(lights["light_buffers"].as_u64().unwrap() >= 1);
+    for j in [&one, &lights, &thesis] {
+        let (all, global) = (
+            j["build_ms"].as_f64().unwrap(),
+            j["global_build_ms"].as_f64().unwrap(),
+        );
+        assert!(
+            global > 0.0 && global <= all,
+            "the global BVH's part of the build: {j}"
+        );
+    }
     // The point light's buffer saves triangle tests on the room's shadow rays.
     assert!(lights["shadow_triangle_tests"].as_u64() < one["shadow_triangle_tests"].as_u64());
 }
@@ -110,6 +120,7 @@ fn json_has_the_contract_keys() {
         "spp",
         "structure",
         "build_ms",
+        "global_build_ms",
         "render_ms",
         "camera_rays",
         "shadow_rays",

@@ -123,7 +123,7 @@ pub fn render() -> String {
          bits; 16 x 16 tiles run on the threads, with a progress bar when standard error is a\n\
          terminal.\n\
          Structures: camera and bounce rays go through the global BVH (binned SAH, reinsertion,\n\
-         4-wide nodes). Shadow segments go through --structure: global, the same BVH; lights, a\n\
+         8-wide nodes). Shadow segments go through --structure: global, the same BVH; lights, a\n\
          light buffer per light (a cube map of directions around it, each cell holding a BVH of\n\
          what segments toward the light through that cell can hit; emissive triangles are\n\
          clustered per material, at most 32 buffers, for the most powerful lights), with the\n\
@@ -131,25 +131,26 @@ pub fn render() -> String {
          1 sample, traced through the global BVH first) decides: a light wider than half its\n\
          pilot segments' median length gets no buffer built, and a buffer built is kept\n\
          only where those segments need at most 0.7 of the global BVH's node + triangle tests\n\
-         through it; build_ms includes the pilot. thesis, the thesis's own\n\
-         structure with influence areas made from the lights: six 90-degree frustums around a\n\
-         point light (one per cube face, apex at the light, to the scene's far end), one frustum\n\
-         along a spot of at most 120 degrees (six for a wider one), an oriented box in front of\n\
-         a quad light or an emissive cluster (both sides); a local BVH per area (pah preset),\n\
-         an octree over the areas and the global BVH as the fallback. A segment whose origin is\n\
-         inside an area and which runs toward its light (within 1 degree of the radial direction\n\
-         for a frustum; ending inside the box for a box) is answered by that area's local BVH up\n\
-         to where it leaves the area, the rest by the fallback. Every structure answers exactly\n\
+         through it; build_ms includes the pilot (global_build_ms is the global BVH's part).\n\
+         thesis, the thesis's own structure with influence areas made from the lights: six\n\
+         90-degree frustums around a point light (one per cube face, apex at the light, to the\n\
+         scene's far end), one frustum along a spot of at most 120 degrees (six for a wider one),\n\
+         an oriented box in front of a quad light or an emissive cluster (both sides); a local\n\
+         BVH per area (pah preset), an octree over the areas and the global BVH as the\n\
+         fallback. A segment whose origin is inside an area and which runs toward its light\n\
+         (within 1 degree of the radial direction for a frustum; ending inside the box for a\n\
+         box) is answered by that area's local BVH up to where it leaves the area, the rest by\n\
+         the fallback. Every structure answers exactly\n\
          as the global BVH does: the images are byte-identical.\n\
          shadow_ms is the best of --shadow-replays single-thread replays of the frame's shadow\n\
          segments (its first 2097152 when it has more) through the structure alone, without\n\
          counters; the replay's answers must equal the frame's.\n\
          --json prints one object as the last line, with the keys scene, triangles, lights,\n\
          light_buffers, light_buffers_dropped, light_buffers_skipped, pilot_shadow_rays,\n\
-         influence_areas,\n\
-         influence_area_triangles, width, height, spp, max_bounces, seed, threads, structure, build_ms,\n\
-         render_ms, camera_rays, shadow_rays, bounce_rays, shadow_occluded, shadow_node_tests,\n\
-         shadow_triangle_tests, shadow_replay_rays, shadow_ms, mean_luminance and out.\n\
+         influence_areas, influence_area_triangles, width, height, spp, max_bounces, seed,\n\
+         threads, structure, build_ms, global_build_ms, render_ms, camera_rays, shadow_rays,\n\
+         bounce_rays, shadow_occluded, shadow_node_tests, shadow_triangle_tests,\n\
+         shadow_replay_rays, shadow_ms, mean_luminance and out.\n\
          --record-rays DIR writes the first --record-limit rays of each kind (in tile order, then\n\
          pixel, sample and path vertex) as `rdbvh trace --rays` reads them, with the renderer's\n\
          answers as `rdbvh trace --out` writes them: replay shadow_rays.csv with --any-hit.\n\n\

@@ -138,6 +138,8 @@ pub struct RenderReport {
     /// Wall-clock milliseconds of the structure's build (global BVH, light buffers and the pilot
     /// frame that chose among them).
     pub build_ms: f64,
+    /// The global BVH's share of `build_ms` (all of it for `global`).
+    pub global_build_ms: f64,
     /// Wall-clock milliseconds of the frame.
     pub render_ms: f64,
     /// Camera rays traced.
@@ -148,7 +150,7 @@ pub struct RenderReport {
     pub bounce_rays: u64,
     /// Shadow segments that something blocked.
     pub shadow_occluded: u64,
-    /// Inner nodes the shadow segments visited, 4-wide nodes for every structure (a light
+    /// Inner nodes the shadow segments visited, 8-wide nodes for every structure (a light
     /// buffer's cell lookup, and the `thesis` octree's, counts as one).
     pub shadow_node_tests: u64,
     /// Ray/triangle tests of the shadow segments.
@@ -269,6 +271,7 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         threads: rayon::current_num_threads(),
         structure: structure.kind().name(),
         build_ms: structure.build_ms(),
+        global_build_ms: structure.global_build_ms(),
         render_ms: frame.render_ms,
         camera_rays: c.camera_rays,
         shadow_rays: c.shadow_rays,

@@ -9,7 +9,10 @@
 //! conservative margins, and boxed by the clipped part of each triangle, so a triangle crossing
 //! many cells costs each cell only its own piece. Cells subdivide as a quadtree while that splits
 //! their triangles; a lookup is one index into the finest grid. Cells the light does not
-//! illuminate (behind a one-sided light, outside a spot's cone) hold nothing.
+//! illuminate (behind a one-sided light, outside a spot's cone) hold nothing. Each tree's nodes
+//! list their children nearest the light first: an any-hit query meets the occluders between
+//! the light and the receiver before the receiver's own neighbourhood, which its segment starts
+//! in and which rarely blocks it.
 //!
 //! A query is one cell lookup plus an any-hit traversal of that cell's tree with the scene's own
 //! triangle test, over a superset of the triangles the segment can touch: the answer is the one a

@@ -332,7 +332,9 @@ impl Leaf {
             Builder::sah().for_wide().build_into(arena, &mut self.bvh)?;
             out.stats.trees += 1;
             out.stats.references += self.local.len();
-            let tree = WideBvh8::from_binary(&self.bvh, &self.local);
+            let mut tree = WideBvh8::from_binary(&self.bvh, &self.local);
+            let light = build.source.bounds.center();
+            tree.order_children(|b| -b.center().distance_squared(light));
             out.forest.append(&tree).unwrap_or(CLEAR)
         };
         let span = 1u32 << (build.options.max_level - task.level);

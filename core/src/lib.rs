@@ -39,7 +39,7 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 
 extern crate alloc;
-#[cfg(feature = "rayon")]
+#[cfg(any(feature = "std", test))]
 extern crate std;
 
 pub mod analyze;

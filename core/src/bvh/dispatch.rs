@@ -25,9 +25,9 @@ pub enum SimdLevel {
 }
 
 /// True when the build can choose at run time (see the module documentation).
+#[cfg(target_arch = "x86_64")]
 const DISPATCH: bool = cfg!(all(
     feature = "std",
-    target_arch = "x86_64",
     not(target_feature = "avx2"),
     not(miri)
 ));

@@ -279,8 +279,27 @@ mod tests {
     where
         Width<W>: Lanes<W>,
     {
+        // The same rays moved onto a plane of some child's box with a zero direction component
+        // along it: there the slab values are NaN (`0 * inf`), which both paths must ignore.
+        let mut rng = Pcg32::new(7);
+        let on_planes: Vec<Ray> = rays
+            .iter()
+            .filter_map(|r| {
+                let node = &wide.nodes[rng.next_u32() as usize % wide.nodes.len()];
+                let b = node.child_bounds(rng.next_u32() as usize % node.arity());
+                let k = rng.next_u32() as usize % 3;
+                let (mut o, mut d) = (r.origin, r.dir);
+                o[k] = if rng.next_u32() & 1 == 0 {
+                    b.min[k]
+                } else {
+                    b.max[k]
+                };
+                d[k] = 0.0;
+                Ray::segment(o, d, r.t_min, r.t_max).ok()
+            })
+            .collect();
         let mut hits = 0;
-        for (i, r) in rays.iter().enumerate() {
+        for (i, r) in rays.iter().chain(&on_planes).enumerate() {
             let (mut s0, mut s1) = (TraversalStats::default(), TraversalStats::default());
             let base = wide.closest_from_root(r, &mut s0);
             // SAFETY: the caller checked the CPU.

@@ -3,10 +3,11 @@
 //! `wide`'s vectors pick their instructions when the crate is compiled: for the default x86-64
 //! target (SSE2) an `f32x8` is two SSE halves, and an 8-wide node test costs twice the
 //! instructions it needs on a CPU with AVX. With the `std` feature (which the host crate and
-//! `rayon` turn on), x86-64 builds therefore also carry the traversals compiled for AVX2
+//! `rayon` turn on), x86-64 builds therefore also carry the 8-wide traversals compiled for AVX2
 //! (`super::avx2`), and the first query checks the CPU once and keeps the answer: from then on a
 //! query pays one relaxed load and a predictable branch. Both paths compute the same answers bit
-//! for bit.
+//! for bit. 4-wide trees keep the baseline: their lanes are one SSE register either way, and
+//! AVX2 gained them nothing measurable.
 //!
 //! There is nothing to choose, and the traversals call the compiled path directly, when the crate
 //! is built without `std` (no CPU detection on bare metal), for another architecture, under Miri

@@ -807,8 +807,12 @@ impl Report {
         );
         let _ = writeln!(
             w,
-            "load average {} before, {} after; build_mt on {} threads",
-            self.load[0], self.load[1], self.threads
+            "load average {} before, {} after; build_mt on {} threads; rdbvh-wide8 traverses \
+             with {:?} (RDBVH_SIMD=baseline for the compiled baseline)",
+            self.load[0],
+            self.load[1],
+            self.threads,
+            rdbvh_core::bvh::simd_level()
         );
         let _ = writeln!(
             w,

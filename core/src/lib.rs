@@ -32,14 +32,15 @@
 //! | [`light_buffer`] | a shadow-ray structure around one light, cells of the light's view | |
 //! | [`analyze`] | the composable BVH analyzer, estimated and measured cost, EPO, overlap | analyzer |
 //!
-//! Features: `rayon` (off) builds on every thread of rayon's pool and needs `std`; without it the
-//! crate is `no_std` + `alloc`.
+//! Features: `std` (off) lets x86-64 builds choose the wide traversals' instructions at run time
+//! (AVX2 where the CPU has it: [`bvh::simd_level`]); `rayon` (off) builds on every thread of
+//! rayon's pool and implies `std`. Without them the crate is `no_std` + `alloc`.
 #![no_std]
 #![deny(missing_docs)]
 #![forbid(unsafe_op_in_unsafe_fn)]
 
 extern crate alloc;
-#[cfg(feature = "rayon")]
+#[cfg(any(feature = "std", test))]
 extern crate std;
 
 pub mod analyze;

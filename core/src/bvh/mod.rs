@@ -1,7 +1,10 @@
 //! Flat binary BVHs: node arrays with adjacent children, a primitive-index array, and the maximum
 //! depth recorded at build time so that traversal stacks are provably large enough.
 
+#[cfg(target_arch = "x86_64")]
+mod avx2;
 mod collapse;
+mod dispatch;
 mod node;
 mod traversable;
 mod traverse;
@@ -11,6 +14,7 @@ mod wide_traverse;
 
 use alloc::vec::Vec;
 
+pub use dispatch::{set_simd_level, simd_level, SimdLevel};
 pub use node::BvhNode;
 pub use traversable::Traversable;
 pub use traverse::{AllHitStats, Hit, TraversalStats};

@@ -12,7 +12,7 @@ use crate::geometry::{pad_far, Ray, RayTri4, Triangle4};
 
 /// The pending entries of a `W`-wide traversal: each visited node pops one entry and pushes at
 /// most `W`, so they grow by at most `W - 1` per level of the (at most [`MAX_DEPTH`] deep) tree.
-const fn wide_stack(w: usize) -> usize {
+pub(crate) const fn wide_stack(w: usize) -> usize {
     (w - 1) * MAX_DEPTH as usize + w
 }
 
@@ -438,12 +438,14 @@ where
     /// The one wide traversal: every node whose box the segment up to `visitor.t_max()` touches,
     /// nearest first when the visitor is ordered, with `visitor` called at each leaf until it
     /// returns true (then this returns true). Closest hit, any hit and the all-hit count are
-    /// visitors over it; so can a caller's own leaf test be.
+    /// visitors over it; so can a caller's own leaf test be. With the `std` feature, an 8-wide
+    /// tree runs the loop, the visitor inlined into it, compiled for AVX2 where the CPU has it
+    /// ([`crate::bvh::simd_level`]).
     pub fn traverse<V: LeafVisitor>(&self, ray: &Ray, visitor: &mut V) -> bool {
         if self.nodes.is_empty() || self.misses_root(ray) {
             return false;
         }
-        self.walk(0, ray, visitor, &mut ())
+        self.walk_dispatched(ray, visitor, &mut ())
     }
 
     /// [`super::WideBvh::traverse`], adding what it did to `stats` (see
@@ -457,7 +459,25 @@ where
         if self.nodes.is_empty() || self.misses_root(ray) {
             return false;
         }
-        self.walk(0, ray, visitor, stats)
+        self.walk_dispatched(ray, visitor, stats)
+    }
+
+    /// [`WideBvhN::walk`] from the root, through the AVX2 entry point where the CPU has it
+    /// ([`super::dispatch`]).
+    #[inline(always)]
+    fn walk_dispatched<V: LeafVisitor>(
+        &self,
+        ray: &Ray,
+        visitor: &mut V,
+        stats: &mut impl Counters,
+    ) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if super::dispatch::avx2_entry::<W>() {
+            // SAFETY: `avx2_entry` is true only once the CPU was seen to have what the entry
+            // points are compiled for.
+            return unsafe { super::avx2::traverse(self, ray, visitor, stats) };
+        }
+        self.walk::<Width<W>, V>(0, ray, visitor, stats)
     }
 
     /// The closest hit on `[ray.t_min, ray.t_max]`, exactly as the binary BVH and brute force
@@ -510,15 +530,30 @@ where
         if self.nodes.is_empty() || self.misses_root(ray) {
             return None;
         }
+        #[cfg(target_arch = "x86_64")]
+        if super::dispatch::avx2_entry::<W>() {
+            // SAFETY: as in `walk_dispatched`.
+            return unsafe { super::avx2::closest(self, ray, stats) };
+        }
         self.closest_from_root(ray, stats)
     }
 
     /// The closest-hit traversal proper, out of line: its frame (saved registers, the stack of
     /// pending entries) is set up only for rays that get past [`WideBvh::misses_root`].
     #[inline(never)]
-    fn closest_from_root(&self, ray: &Ray, stats: &mut impl Counters) -> Option<Hit> {
+    pub(crate) fn closest_from_root(&self, ray: &Ray, stats: &mut impl Counters) -> Option<Hit> {
+        self.closest_walk::<Width<W>>(ray, stats)
+    }
+
+    /// The closest-hit walk on lanes `L`, for [`WideBvh::closest_from_root`] and its AVX2 twin.
+    #[inline(always)]
+    pub(crate) fn closest_walk<L: Lanes<W>>(
+        &self,
+        ray: &Ray,
+        stats: &mut impl Counters,
+    ) -> Option<Hit> {
         let mut visitor = ClosestHit::new(ray);
-        self.walk(0, ray, &mut visitor, stats);
+        self.walk::<L, _>(0, ray, &mut visitor, stats);
         visitor.best
     }
 
@@ -537,21 +572,43 @@ where
         if self.nodes.is_empty() || self.misses_root(ray) {
             return false;
         }
-        self.any_from_root(0, ray, stats)
+        self.any_dispatched(0, ray, stats)
+    }
+
+    /// [`WideBvh::any_from_root`], through the AVX2 entry point where the CPU has it.
+    #[inline(always)]
+    fn any_dispatched(&self, root: u32, ray: &Ray, stats: &mut impl Counters) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if super::dispatch::avx2_entry::<W>() {
+            // SAFETY: as in `walk_dispatched`.
+            return unsafe { super::avx2::any(self, root, ray, stats) };
+        }
+        self.any_from_root(root, ray, stats)
     }
 
     /// [`WideBvh::any_hit_with_stats`] from node `root` of a forest ([`WideBvh::append`]), with no
     /// root-box test: a tree the caller chose for the ray.
     #[inline]
     pub(crate) fn any_hit_from(&self, root: u32, ray: &Ray, stats: &mut impl Counters) -> bool {
-        self.any_from_root(root, ray, stats)
+        self.any_dispatched(root, ray, stats)
     }
 
     /// The any-hit traversal proper from node `root`, out of line (see
     /// [`WideBvh::closest_from_root`]).
     #[inline(never)]
-    fn any_from_root(&self, root: u32, ray: &Ray, stats: &mut impl Counters) -> bool {
-        self.walk(root, ray, &mut AnyHit::new(ray), stats)
+    pub(crate) fn any_from_root(&self, root: u32, ray: &Ray, stats: &mut impl Counters) -> bool {
+        self.any_walk::<Width<W>>(root, ray, stats)
+    }
+
+    /// The any-hit walk on lanes `L`, for [`WideBvh::any_from_root`] and its AVX2 twin.
+    #[inline(always)]
+    pub(crate) fn any_walk<L: Lanes<W>>(
+        &self,
+        root: u32,
+        ray: &Ray,
+        stats: &mut impl Counters,
+    ) -> bool {
+        self.walk::<L, _>(root, ray, &mut AnyHit::new(ray), stats)
     }
 
     /// The all-hit walk: every wide node whose box the segment touches (`inner_nodes`), every
@@ -572,17 +629,18 @@ where
     /// The loop every query shares, from node `root` (the root box test done or skipped by the
     /// caller). It keeps the node it is in rather than pushing and popping it: a node with one
     /// child hit goes straight on to it, and one with several pushes all but the one it goes to
-    /// (for an ordered visitor the nearest, the rest pushed farthest first).
+    /// (for an ordered visitor the nearest, the rest pushed farthest first). Generic over the
+    /// lanes `L` so that the AVX2 entry points ([`super::dispatch`]) instantiate the same loop.
     #[inline(always)]
-    fn walk<V: LeafVisitor>(
+    pub(crate) fn walk<L: Lanes<W>, V: LeafVisitor>(
         &self,
         root: u32,
         ray: &Ray,
         visitor: &mut V,
         stats: &mut impl Counters,
     ) -> bool {
-        let r = RayN::<<Width<W> as Lanes<W>>::V>::new(ray);
-        let mut stack = <<Width<W> as Lanes<W>>::Pending as Pending>::new();
+        let r = RayN::<L::V>::new(ray);
+        let mut stack = L::Pending::new();
         let (mut child, mut count) = (root, 0u32);
         loop {
             if count == 0 {

@@ -4,6 +4,12 @@
 //!
 //! - `render/SCENE/shadow/{global,lights,thesis}`: the frame's shadow segments answered on one
 //!   thread, as `shadow_ms` replays them (throughput in segments);
+//! - `render/SCENE/in_frame/{closest_alone,global,lights,thesis}`: the same shadow segments
+//!   with the frame's camera and bounce rays (closest hit, through the structure's global BVH) interleaved
+//!   between them in their frame order and ratio, on one thread; `closest_alone` traces those
+//!   closest-hit rays alone. A structure's time minus `closest_alone` is what its shadow
+//!   segments cost inside a frame, where the global BVH's nodes and triangles share the caches
+//!   with theirs (a light buffer is a second copy of the scene the global BVH does not warm);
 //! - `render/SCENE/build/{global,lights,thesis}`: building the structure, the `lights` pilot
 //!   frame included (two threads).
 //!
@@ -24,6 +30,7 @@ use rdbvh::render::{
 use rdbvh::scene::Scene;
 use rdbvh_benches::scenes_dir;
 use rdbvh_core::bvh::TraversalStats;
+use rdbvh_core::geometry::Ray;
 
 const SIZE: (u32, u32) = (128, 128);
 const SPP: u32 = 2;
@@ -118,8 +125,9 @@ impl Loaded {
         built.expect("the structure builds")
     }
 
-    /// The frame's shadow segments, rendered through the global BVH.
-    fn shadow_segments(&self) -> Vec<ShadowRay> {
+    /// The frame's shadow segments and its camera and bounce rays (merged in frame order, in
+    /// their ratio), rendered through the global BVH.
+    fn frame_rays(&self) -> (Vec<ShadowRay>, Vec<Ray>) {
         let global = self.build(StructureKind::Global);
         let integrator =
             Integrator::new(&self.scene, &self.lights, &global, BOUNCES).expect("an integrator");
@@ -128,10 +136,26 @@ impl Loaded {
             height: SIZE.1,
             spp: SPP,
             seed: SEED,
-            record_limit: 0,
+            record_limit: usize::MAX,
             progress: false,
         };
-        render_frame(&integrator, &self.camera(SIZE), &settings).shadow_rays
+        let frame = render_frame(&integrator, &self.camera(SIZE), &settings);
+        let (camera, bounce) = (&frame.recorded.camera, &frame.recorded.bounce);
+        let total = camera.len() + bounce.len();
+        // Ray `k` of the merge is camera ray `k * camera / total`'s successor when that index
+        // moves, else the next bounce ray: both kinds stay in frame order, spread evenly.
+        let mut closest = Vec::with_capacity(total);
+        let (mut c, mut b) = (0, 0);
+        for k in 0..total {
+            if c < camera.len() && (c * total <= k * camera.len() || b == bounce.len()) {
+                closest.push(camera[c].0);
+                c += 1;
+            } else {
+                closest.push(bounce[b].0);
+                b += 1;
+            }
+        }
+        (frame.shadow_rays, closest)
     }
 }
 
@@ -144,7 +168,7 @@ fn render(c: &mut Criterion) {
                 continue;
             }
         };
-        let shadow = loaded.shadow_segments();
+        let (shadow, closest) = loaded.frame_rays();
         let kinds = [
             StructureKind::Global,
             StructureKind::Lights,
@@ -187,6 +211,7 @@ fn render(c: &mut Criterion) {
             });
         }
         group.finish();
+        in_frame(c, case.name, &kinds, &structures, &shadow, &closest);
         let mut group = c.benchmark_group(format!("render/{}/build", case.name));
         group
             .sample_size(10)
@@ -199,6 +224,49 @@ fn render(c: &mut Criterion) {
         }
         group.finish();
     }
+}
+
+/// The `in_frame` group: each shadow segment followed by its share of the frame's closest-hit
+/// rays, against those closest-hit rays alone.
+fn in_frame(
+    c: &mut Criterion,
+    name: &str,
+    kinds: &[StructureKind],
+    structures: &[Structure],
+    shadow: &[ShadowRay],
+    closest: &[Ray],
+) {
+    let mut group = c.benchmark_group(format!("render/{name}/in_frame"));
+    group
+        .throughput(Throughput::Elements(shadow.len() as u64))
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(3));
+    let global = &structures[0];
+    group.bench_function("closest_alone", |b| {
+        b.iter(|| {
+            black_box(closest)
+                .iter()
+                .filter(|r| global.closest_hit(r).is_some())
+                .count()
+        })
+    });
+    let (n, m) = (shadow.len().max(1), closest.len());
+    for (kind, structure) in kinds.iter().zip(structures) {
+        group.bench_function(kind.name(), |b| {
+            b.iter(|| {
+                let mut hits = 0;
+                for (i, s) in black_box(shadow).iter().enumerate() {
+                    hits += usize::from(structure.occluded(s.light as usize, &s.ray));
+                    for r in &closest[i * m / n..(i + 1) * m / n] {
+                        hits += usize::from(structure.closest_hit(r).is_some());
+                    }
+                }
+                hits
+            })
+        });
+    }
+    group.finish();
 }
 
 criterion_group!(benches, render);

@@ -131,7 +131,8 @@ pub fn render() -> String {
          1 sample, traced through the global BVH first) decides: a light wider than half its\n\
          pilot segments' median length gets no buffer built, and a buffer built is kept\n\
          only where those segments need at most 0.7 of the global BVH's node + triangle tests\n\
-         through it; build_ms includes the pilot (global_build_ms is the global BVH's part).\n\
+         through it; build_ms includes the pilot (global_build_ms is the global BVH's part,\n\
+         pilot_ms the pilot frame's).\n\
          thesis, the thesis's own structure with influence areas made from the lights: six\n\
          90-degree frustums around a point light (one per cube face, apex at the light, to the\n\
          scene's far end), one frustum along a spot of at most 120 degrees (six for a wider one),\n\
@@ -148,7 +149,8 @@ pub fn render() -> String {
          --json prints one object as the last line, with the keys scene, triangles, lights,\n\
          light_buffers, light_buffers_dropped, light_buffers_skipped, pilot_shadow_rays,\n\
          influence_areas, influence_area_triangles, width, height, spp, max_bounces, seed,\n\
-         threads, structure, build_ms, global_build_ms, render_ms, camera_rays, shadow_rays,\n\
+         threads, structure, build_ms, global_build_ms, pilot_ms, render_ms, camera_rays,\n\
+         shadow_rays,\n\
          bounce_rays, shadow_occluded, shadow_node_tests, shadow_triangle_tests,\n\
          shadow_replay_rays, shadow_ms, mean_luminance and out.\n\
          --record-rays DIR writes the first --record-limit rays of each kind (in tile order, then\n\

@@ -140,6 +140,9 @@ pub struct RenderReport {
     pub build_ms: f64,
     /// The global BVH's share of `build_ms` (all of it for `global`).
     pub global_build_ms: f64,
+    /// The pilot frame's share of `build_ms` (`lights` only, 0 otherwise): what is left,
+    /// `build_ms - global_build_ms - pilot_ms`, is the light buffers and the choice among them.
+    pub pilot_ms: f64,
     /// Wall-clock milliseconds of the frame.
     pub render_ms: f64,
     /// Camera rays traced.
@@ -272,6 +275,7 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         structure: structure.kind().name(),
         build_ms: structure.build_ms(),
         global_build_ms: structure.global_build_ms(),
+        pilot_ms: pilot.ms,
         render_ms: frame.render_ms,
         camera_rays: c.camera_rays,
         shadow_rays: c.shadow_rays,

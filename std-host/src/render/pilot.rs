@@ -46,7 +46,7 @@ pub struct PilotReport {
     pub dropped: usize,
     /// Of those dropped, the ones decided before building ([`build_lights`]).
     pub skipped: usize,
-    /// Wall-clock milliseconds of the pilot and the decision.
+    /// Wall-clock milliseconds of the pilot frame (its render, through the global BVH).
     pub ms: f64,
 }
 

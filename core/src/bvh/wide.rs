@@ -257,9 +257,9 @@ impl<const W: usize> WideBvhN<W> {
     }
 
     /// Reorders every node's children by `key` of their boxes, largest first, the unused slots
-    /// last. Unordered traversals (any hit, the all-hit count) visit children in slot order, so
-    /// for rays of a known direction this puts the child likeliest to end an any-hit query
-    /// first; answers do not change, only the work before them.
+    /// last. Unordered traversals (any hit, the all-hit count) descend first into the lowest
+    /// slot the ray hits, so for rays of a known direction this sends an any-hit query first
+    /// into the child likeliest to end it; answers do not change, only the work before them.
     pub(crate) fn order_children(&mut self, key: impl Fn(&Aabb) -> f32) {
         for node in &mut self.nodes {
             let mut slots: [usize; W] = core::array::from_fn(|i| i);

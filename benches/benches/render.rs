@@ -5,9 +5,9 @@
 //! - `render/SCENE/shadow/{global,lights,thesis}`: the frame's shadow segments answered on one
 //!   thread, as `shadow_ms` replays them (throughput in segments);
 //! - `render/SCENE/in_frame/{closest_alone,global,lights,thesis}`: the same shadow segments
-//!   with the frame's camera and bounce rays (closest hit, through the structure's global BVH) interleaved
-//!   between them in their frame order and ratio, on one thread; `closest_alone` traces those
-//!   closest-hit rays alone. A structure's time minus `closest_alone` is what its shadow
+//!   with the frame's camera and bounce rays (closest hit, through the structure's global BVH)
+//!   interleaved between them in their frame order and ratio, on one thread; `closest_alone`
+//!   traces those closest-hit rays alone. A structure's time minus `closest_alone` is what its shadow
 //!   segments cost inside a frame, where the global BVH's nodes and triangles share the caches
 //!   with theirs (a light buffer is a second copy of the scene the global BVH does not warm);
 //! - `render/SCENE/build/{global,lights,thesis}`: building the structure, the `lights` pilot
@@ -142,8 +142,8 @@ impl Loaded {
         let frame = render_frame(&integrator, &self.camera(SIZE), &settings);
         let (camera, bounce) = (&frame.recorded.camera, &frame.recorded.bounce);
         let total = camera.len() + bounce.len();
-        // Ray `k` of the merge is camera ray `k * camera / total`'s successor when that index
-        // moves, else the next bounce ray: both kinds stay in frame order, spread evenly.
+        // Camera ray `c` takes position `c * total / camera` of the merge and bounce rays fill
+        // the rest: both kinds stay in frame order, spread evenly.
         let mut closest = Vec::with_capacity(total);
         let (mut c, mut b) = (0, 0);
         for k in 0..total {

@@ -107,6 +107,11 @@ fn images_depend_on_the_seed_alone_whatever_the_threads_and_structure() {
             "the global BVH's and the pilot's parts of the build: {j}"
         );
     }
+    assert!(
+        lights["pilot_ms"].as_f64().unwrap() > 0.0,
+        "lights renders a pilot frame"
+    );
+    assert_eq!(one["pilot_ms"].as_f64(), Some(0.0), "global renders none");
     // The point light's buffer saves triangle tests on the room's shadow rays.
     assert!(lights["shadow_triangle_tests"].as_u64() < one["shadow_triangle_tests"].as_u64());
 }

@@ -150,8 +150,7 @@ pub fn render() -> String {
          light_buffers, light_buffers_dropped, light_buffers_skipped, pilot_shadow_rays,\n\
          influence_areas, influence_area_triangles, width, height, spp, max_bounces, seed,\n\
          threads, structure, build_ms, global_build_ms, pilot_ms, render_ms, camera_rays,\n\
-         shadow_rays,\n\
-         bounce_rays, shadow_occluded, shadow_node_tests, shadow_triangle_tests,\n\
+         shadow_rays, bounce_rays, shadow_occluded, shadow_node_tests, shadow_triangle_tests,\n\
          shadow_replay_rays, shadow_ms, mean_luminance and out.\n\
          --record-rays DIR writes the first --record-limit rays of each kind (in tile order, then\n\
          pixel, sample and path vertex) as `rdbvh trace --rays` reads them, with the renderer's\n\

@@ -5,7 +5,7 @@
 //! SCENE is an OBJ path or `builtin:NAME` (default `builtin:room`); the point light sits over the
 //! centre of the scene's bounds at HEIGHT (a fraction of the bounds' height, default 0.6). Shadow
 //! segments run from the first hits of a pinhole camera's rays (512 x 512, in 16 x 16 tiles, as a
-//! renderer shoots them) to the light. The example builds the global BVH (SAH, reinsertion, 4-wide)
+//! renderer shoots them) to the light. The example builds the global BVH (SAH, reinsertion, 8-wide)
 //! and the light buffer (its six faces on rayon's threads), checks that every answer agrees, and
 //! prints the node and triangle tests per ray and the single-thread query time of each.
 
@@ -14,7 +14,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use rdbvh::scene::Scene;
 use rdbvh_core::builder::{reinsert, Builder, ReinsertConfig};
-use rdbvh_core::bvh::{TraversalStats, WideBvh};
+use rdbvh_core::bvh::{TraversalStats, WideBvh8};
 use rdbvh_core::geometry::Ray;
 use rdbvh_core::heuristics::Sah;
 use rdbvh_core::light_buffer::{LightBufferBuilder, LightBufferOptions, LightSource};
@@ -38,12 +38,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let start = Instant::now();
     let mut bvh = Builder::sah().build(tris)?;
     reinsert(&mut bvh, &Sah, &ReinsertConfig::default());
-    let global = WideBvh::from_binary(&bvh, tris);
+    let global = WideBvh8::from_binary(&bvh, tris);
     let global_ms = start.elapsed().as_secs_f64() * 1e3;
 
     let start = Instant::now();
     let build = LightBufferBuilder::new(
         tris,
+        &global,
         LightSource::point(light)?,
         &LightBufferOptions::default(),
     )?;
@@ -107,7 +108,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut occluded = 0;
     for ray in &rays {
         let answer = global.any_hit_with_stats(ray, &mut g);
-        if buffer.occluded_with_stats(ray, &mut l) != Some(answer) {
+        if buffer.occluded_with_stats(&global, ray, &mut l) != Some(answer) {
             return Err(
                 format!("the light buffer disagrees with the global BVH on {ray:?}").into(),
             );
@@ -137,7 +138,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let tg = best(&|| rays.iter().filter(|r| global.any_hit(r)).count());
     let tl = best(&|| {
         rays.iter()
-            .filter(|r| buffer.occluded(r) == Some(true))
+            .filter(|r| buffer.occluded(&global, r) == Some(true))
             .count()
     });
     println!(

@@ -19,7 +19,7 @@ use super::traverse::Stack;
 use super::wide::{WideBvh8, WideBvhN};
 use super::wide_traverse::{wide_stack, ChildLanes, Counters, Entry, Lanes, LeafVisitor, Width};
 use super::Hit;
-use crate::geometry::Ray;
+use crate::geometry::{Ray, Triangle4};
 
 /// Eight child lanes in one AVX register.
 ///
@@ -148,7 +148,8 @@ where
     }
 }
 
-/// [`WideBvhN::walk`] from `root` with an any-hit visitor, compiled for AVX2.
+/// [`WideBvhN::walk`] from `root` with an any-hit visitor and leaves in `tris`, compiled for
+/// AVX2.
 ///
 /// # Safety
 ///
@@ -157,6 +158,7 @@ where
 pub(crate) unsafe fn any<const W: usize>(
     bvh: &WideBvhN<W>,
     root: u32,
+    tris: &[Triangle4],
     ray: &Ray,
     stats: &mut impl Counters,
 ) -> bool
@@ -164,8 +166,8 @@ where
     Width<W>: Lanes<W>,
 {
     match bvh.as_wide8() {
-        Some(bvh) => bvh.any_walk::<Avx2Lanes8>(root, ray, stats),
-        None => bvh.any_walk::<Width<W>>(root, ray, stats),
+        Some(bvh) => bvh.any_walk::<Avx2Lanes8>(root, tris, ray, stats),
+        None => bvh.any_walk::<Width<W>>(root, tris, ray, stats),
     }
 }
 
@@ -309,9 +311,9 @@ mod tests {
             hits += u32::from(base.is_some());
 
             let (mut s0, mut s1) = (TraversalStats::default(), TraversalStats::default());
-            let base = wide.any_from_root(0, r, &mut s0);
+            let base = wide.any_from_root(0, wide.triangles(), r, &mut s0);
             // SAFETY: as above.
-            let avx = unsafe { any(wide, 0, r, &mut s1) };
+            let avx = unsafe { any(wide, 0, wide.triangles(), r, &mut s1) };
             assert_eq!((base, s0), (avx, s1), "any, ray {i}");
 
             let (mut s0, mut s1) = (TraversalStats::default(), TraversalStats::default());

@@ -56,7 +56,8 @@ impl<const W: usize> WideNodeN<W> {
     /// The `child` value of an unused slot.
     pub const EMPTY: u32 = u32::MAX;
 
-    const UNUSED: Self = Self {
+    /// A node with every slot unused.
+    pub(crate) const UNUSED: Self = Self {
         min: [[f32::INFINITY; W]; 3],
         max: [[f32::NEG_INFINITY; W]; 3],
         child: [Self::EMPTY; W],
@@ -76,7 +77,8 @@ impl<const W: usize> WideNodeN<W> {
         self.child.iter().filter(|&&c| c != Self::EMPTY).count()
     }
 
-    fn set(&mut self, i: usize, bounds: Aabb, child: u32, count: u32) {
+    /// Fills slot `i`: `child` is a node index (`count` 0) or a leaf's first block.
+    pub(crate) fn set(&mut self, i: usize, bounds: Aabb, child: u32, count: u32) {
         for k in 0..3 {
             self.min[k][i] = bounds.min[k];
             self.max[k][i] = bounds.max[k];

@@ -572,32 +572,52 @@ where
         if self.nodes.is_empty() || self.misses_root(ray) {
             return false;
         }
-        self.any_dispatched(0, ray, stats)
+        self.any_dispatched(0, &self.tris, ray, stats)
     }
 
     /// [`WideBvh::any_from_root`], through the AVX2 entry point where the CPU has it.
     #[inline(always)]
-    fn any_dispatched(&self, root: u32, ray: &Ray, stats: &mut impl Counters) -> bool {
+    fn any_dispatched(
+        &self,
+        root: u32,
+        tris: &[Triangle4],
+        ray: &Ray,
+        stats: &mut impl Counters,
+    ) -> bool {
         #[cfg(target_arch = "x86_64")]
         if super::dispatch::avx2_entry::<W>() {
             // SAFETY: as in `walk_dispatched`.
-            return unsafe { super::avx2::any(self, root, ray, stats) };
+            return unsafe { super::avx2::any(self, root, tris, ray, stats) };
         }
-        self.any_from_root(root, ray, stats)
+        self.any_from_root(root, tris, ray, stats)
     }
 
-    /// [`WideBvh::any_hit_with_stats`] from node `root` of a forest ([`WideBvh::append`]), with no
-    /// root-box test: a tree the caller chose for the ray.
+    /// [`WideBvh::any_hit_with_stats`] from node `root` of a forest ([`WideBvh::append`]) whose
+    /// leaves name blocks of `tris` (its own, or another tree's: a light buffer's cell trees
+    /// point into the scene BVH's blocks), with no root-box test: a tree the caller chose for
+    /// the ray.
     #[inline]
-    pub(crate) fn any_hit_from(&self, root: u32, ray: &Ray, stats: &mut impl Counters) -> bool {
-        self.any_dispatched(root, ray, stats)
+    pub(crate) fn any_hit_from(
+        &self,
+        root: u32,
+        tris: &[Triangle4],
+        ray: &Ray,
+        stats: &mut impl Counters,
+    ) -> bool {
+        self.any_dispatched(root, tris, ray, stats)
     }
 
     /// The any-hit traversal proper from node `root`, out of line (see
     /// [`WideBvh::closest_from_root`]).
     #[inline(never)]
-    pub(crate) fn any_from_root(&self, root: u32, ray: &Ray, stats: &mut impl Counters) -> bool {
-        self.any_walk::<Width<W>>(root, ray, stats)
+    pub(crate) fn any_from_root(
+        &self,
+        root: u32,
+        tris: &[Triangle4],
+        ray: &Ray,
+        stats: &mut impl Counters,
+    ) -> bool {
+        self.any_walk::<Width<W>>(root, tris, ray, stats)
     }
 
     /// The any-hit walk on lanes `L`, for [`WideBvh::any_from_root`] and its AVX2 twin.
@@ -605,10 +625,11 @@ where
     pub(crate) fn any_walk<L: Lanes<W>>(
         &self,
         root: u32,
+        tris: &[Triangle4],
         ray: &Ray,
         stats: &mut impl Counters,
     ) -> bool {
-        self.walk::<L, _>(root, ray, &mut AnyHit::new(ray), stats)
+        self.walk_in::<L, _>(root, tris, ray, &mut AnyHit::new(ray), stats)
     }
 
     /// The all-hit walk: every wide node whose box the segment touches (`inner_nodes`), every
@@ -639,6 +660,20 @@ where
         visitor: &mut V,
         stats: &mut impl Counters,
     ) -> bool {
+        self.walk_in::<L, V>(root, &self.tris, ray, visitor, stats)
+    }
+
+    /// [`WideBvhN::walk`] over this tree's nodes with leaves in `tris`: its own blocks, or the
+    /// blocks of the tree its leaves point into ([`WideBvhN::any_hit_from`]).
+    #[inline(always)]
+    pub(crate) fn walk_in<L: Lanes<W>, V: LeafVisitor>(
+        &self,
+        root: u32,
+        tris: &[Triangle4],
+        ray: &Ray,
+        visitor: &mut V,
+        stats: &mut impl Counters,
+    ) -> bool {
         let r = RayN::<L::V>::new(ray);
         let mut stack = L::Pending::new();
         let (mut child, mut count) = (root, 0u32);
@@ -655,7 +690,7 @@ where
                     } else {
                         // Several children hit: start fetching them all now, so their cache
                         // misses overlap the work on the first (the loop is bound by them).
-                        self.prefetch(node, mask);
+                        Self::prefetch(&self.nodes, tris, node, mask);
                         if V::ORDERED {
                             push_ordered(&mut stack, node, t_near, first, rest)
                         } else {
@@ -675,7 +710,7 @@ where
             } else {
                 stats.leaf(count);
                 let first = child as usize;
-                let blocks = &self.tris[first..first + count.div_ceil(4) as usize];
+                let blocks = &tris[first..first + count.div_ceil(4) as usize];
                 if visitor.leaf(blocks, count) {
                     return true;
                 }
@@ -700,7 +735,7 @@ impl<const W: usize> WideBvhN<W> {
     /// Hints the cache to fetch the children in `mask`: a node's two lines, or a leaf's first
     /// block's three. A hint only: no fault, no effect on any answer.
     #[inline(always)]
-    fn prefetch(&self, node: &WideNodeN<W>, mask: u32) {
+    fn prefetch(nodes: &[WideNodeN<W>], tris: &[Triangle4], node: &WideNodeN<W>, mask: u32) {
         #[cfg(target_arch = "x86_64")]
         {
             use core::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
@@ -711,9 +746,9 @@ impl<const W: usize> WideBvhN<W> {
                 let (child, count) = (node.child[i] as usize, node.count[i]);
                 // `wrapping_add`: the address is only a hint, never dereferenced here.
                 let (p, lines) = if count == 0 {
-                    (self.nodes.as_ptr().wrapping_add(child).cast::<i8>(), 2)
+                    (nodes.as_ptr().wrapping_add(child).cast::<i8>(), 2)
                 } else {
-                    (self.tris.as_ptr().wrapping_add(child).cast::<i8>(), 3)
+                    (tris.as_ptr().wrapping_add(child).cast::<i8>(), 3)
                 };
                 for l in 0..lines {
                     // SAFETY: prefetching is a hint with no memory access semantics; any
@@ -723,7 +758,7 @@ impl<const W: usize> WideBvhN<W> {
             }
         }
         #[cfg(not(target_arch = "x86_64"))]
-        let _ = (node, mask);
+        let _ = (nodes, tris, node, mask);
     }
 }
 

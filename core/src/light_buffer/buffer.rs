@@ -52,36 +52,41 @@ pub struct LightBufferStats {
     pub clear_cells: usize,
     /// Quadtree leaves the light does not illuminate.
     pub dark_cells: usize,
-    /// Triangle references over all trees (a triangle counts once per tree it is in).
+    /// Triangles over all trees: the scene BVH leaves each tree points at, each leaf's
+    /// triangles counted once per tree.
     pub references: usize,
-    /// Bytes of the grid and the trees.
+    /// Bytes of the grid and the trees' nodes (the triangles stay the scene BVH's).
     pub memory_bytes: usize,
 }
 
 /// A light buffer: the shadow-ray structure of one light (see the module documentation).
 ///
 /// ```
-/// use rdbvh_core::bvh::TraversalStats;
+/// use rdbvh_core::bvh::{TraversalStats, WideBvh8};
 /// use rdbvh_core::geometry::{Ray, Triangle};
 /// use rdbvh_core::light_buffer::{LightBuffer, LightBufferOptions, LightSource};
-/// use rdbvh_core::Vec3;
+/// use rdbvh_core::{BuildOptions, Preset, Vec3};
 ///
 /// // A floor and a small occluder under a point light.
 /// let tris = [
 ///     Triangle::new(Vec3::new(-9.0, 0.0, -9.0), Vec3::new(9.0, 0.0, -9.0), Vec3::new(0.0, 0.0, 9.0)),
 ///     Triangle::new(Vec3::new(-1.0, 2.0, -1.0), Vec3::new(1.0, 2.0, -1.0), Vec3::new(0.0, 2.0, 1.0)),
 /// ];
+/// // The scene's BVH, which the buffer's trees point into.
+/// let scene = WideBvh8::from_binary(&BuildOptions::new(Preset::Sah).build(&tris, None)?, &tris);
 /// let light = Vec3::new(0.0, 5.0, 0.0);
-/// let source = LightSource::point(light).unwrap();
-/// let buffer = LightBuffer::build(&tris, source, &LightBufferOptions::default()).unwrap();
+/// let source = LightSource::point(light)?;
+/// let buffer = LightBuffer::build(&tris, &scene, source, &LightBufferOptions::default())?;
 /// // Shadow segments from the floor to the light: under the occluder, and beside it.
 /// let shadow = |p: Vec3| Ray::segment(p, light - p, 0.0, 1.0 - 1e-4).unwrap();
 /// let mut stats = TraversalStats::default();
-/// assert_eq!(buffer.occluded_with_stats(&shadow(Vec3::new(0.0, 0.01, 0.0)), &mut stats), Some(true));
-/// assert_eq!(buffer.occluded(&shadow(Vec3::new(6.0, 0.01, 0.0))), Some(false));
+/// let under = shadow(Vec3::new(0.0, 0.01, 0.0));
+/// assert_eq!(buffer.occluded_with_stats(&scene, &under, &mut stats), Some(true));
+/// assert_eq!(buffer.occluded(&scene, &shadow(Vec3::new(6.0, 0.01, 0.0))), Some(false));
 /// // A segment that does not end on the light is not the buffer's to answer.
-/// let other = Ray::segment(Vec3::ZERO, Vec3::X, 0.0, 1.0).unwrap();
-/// assert_eq!(buffer.occluded(&other), None);
+/// let other = Ray::segment(Vec3::ZERO, Vec3::X, 0.0, 1.0)?;
+/// assert_eq!(buffer.occluded(&scene, &other), None);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Clone, Debug)]
 pub struct LightBuffer {
@@ -91,9 +96,13 @@ pub struct LightBuffer {
     /// Per finest cell, `face * r * r + v * r + u`: the root node of its tree in `forest`,
     /// [`CLEAR`] or [`DARK`].
     pub(crate) grid: Vec<u32>,
-    /// Every cell's tree in one node array and one block array, in the order the quadtree's
-    /// depth-first walk made them: neighbouring cells' trees lie side by side in memory.
+    /// Every cell's tree in one node array, in the order the quadtree's depth-first walk made
+    /// them (neighbouring cells' trees lie side by side in memory). It holds no triangles: each
+    /// leaf names a leaf's blocks in the scene BVH, whose triangles the renderer's other rays
+    /// keep in the caches.
     pub(crate) forest: WideBvh8,
+    /// The scene BVH's node and block counts, checked at each query.
+    pub(crate) scene_size: (usize, usize),
     /// The length margin of every decision ([`super::source::MARGIN`] times the coordinate scale).
     pub(crate) margin: f32,
     /// Where the segments the buffer answers end ([`LightSource::end_box`]).
@@ -103,14 +112,16 @@ pub struct LightBuffer {
 
 impl LightBuffer {
     /// Builds the buffer of `source` over the scene `tris` (the triangles every other structure
-    /// sees, in the same order). Fails on a triangle with a NaN or infinite coordinate or on
-    /// options out of range.
+    /// sees, in the same order) and `scene`, an 8-wide BVH over exactly those triangles, whose
+    /// leaves the buffer's trees name. Fails on a triangle with a NaN or infinite coordinate, a
+    /// `scene` over other triangles, or options out of range.
     pub fn build(
         tris: &[Triangle],
+        scene: &WideBvh8,
         source: LightSource,
         options: &LightBufferOptions,
     ) -> Result<Self, BuildError> {
-        let build = LightBufferBuilder::new(tris, source, options)?;
+        let build = LightBufferBuilder::new(tris, scene, source, options)?;
         let faces = (0..LightBufferBuilder::FACES)
             .map(|face| build.face(face))
             .collect::<Result<Vec<_>, _>>()?;
@@ -134,26 +145,35 @@ impl LightBuffer {
 
     /// [`LightBuffer::occluded_with_stats`] without counting.
     #[inline]
-    pub fn occluded(&self, ray: &Ray) -> Option<bool> {
-        self.query(ray, &mut ())
+    pub fn occluded(&self, scene: &WideBvh8, ray: &Ray) -> Option<bool> {
+        self.query(scene, ray, &mut ())
     }
 
     /// Whether a triangle blocks the shadow segment `ray` (any hit on `[t_min, t_max]`), exactly
     /// as a BVH over the whole scene answers: `Some(answer)` for a segment that ends on the light
     /// (`origin + dir` on its surface, as a renderer's light sample gives) and starts where the
-    /// light sends light; `None` for any other, which the caller answers elsewhere.
+    /// light sends light; `None` for any other, which the caller answers elsewhere. `scene` is
+    /// the BVH the buffer was built with, whose blocks its leaves name; given a BVH of another
+    /// size the buffer answers `None` too.
     ///
     /// The cell lookup counts as one inner node in `stats` (it costs less than one 8-wide box
     /// test), the cell's tree as a [`WideBvh8`] traversal does.
     #[inline]
-    pub fn occluded_with_stats(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<bool> {
-        self.query(ray, stats)
+    pub fn occluded_with_stats(
+        &self,
+        scene: &WideBvh8,
+        ray: &Ray,
+        stats: &mut TraversalStats,
+    ) -> Option<bool> {
+        self.query(scene, ray, stats)
     }
 
     /// The query, counting into `stats` or (with `()`) not at all.
     #[inline(always)]
-    fn query(&self, ray: &Ray, stats: &mut impl Counters) -> Option<bool> {
-        if !self.source.ends_on_light(ray, self.end_box, self.margin) {
+    fn query(&self, scene: &WideBvh8, ray: &Ray, stats: &mut impl Counters) -> Option<bool> {
+        if (scene.nodes.len(), scene.tris.len()) != self.scene_size
+            || !self.source.ends_on_light(ray, self.end_box, self.margin)
+        {
             return None;
         }
         let cell = self.cell(-ray.dir);
@@ -161,7 +181,7 @@ impl LightBuffer {
         match self.grid[cell] {
             DARK => None,
             CLEAR => Some(false),
-            root => Some(self.forest.any_hit_from(root, ray, stats)),
+            root => Some(self.forest.any_hit_from(root, &scene.tris, ray, stats)),
         }
     }
 

@@ -1,6 +1,6 @@
 //! Building a light buffer: per cube-map face, a quadtree of cells refined while that splits the
-//! triangles the cells reach, and a small wide BVH over each leaf's triangles, boxed by their
-//! clipped parts.
+//! triangles the cells reach, and for each leaf a small wide BVH over the scene BVH's leaves that
+//! hold those triangles, boxed by their clipped parts ([`super::cell_tree`]).
 
 use alloc::vec;
 use alloc::vec::Vec;
@@ -9,10 +9,10 @@ use glam::DVec3;
 
 use super::buffer::{LightBuffer, LightBufferOptions, LightBufferStats, CLEAR, DARK};
 use super::cell::{CellRect, CONE_MARGIN, FACES};
+use super::cell_tree::{CellTreeBuilder, SceneLeaves};
 use super::clip::{vertices_f64, Region};
 use super::source::{LightSource, MARGIN};
-use crate::builder::{BuildArena, Builder};
-use crate::bvh::{Bvh, WideBvh8};
+use crate::bvh::WideBvh8;
 use crate::geometry::Triangle;
 use crate::BuildError;
 
@@ -40,6 +40,7 @@ struct Task {
 #[derive(Clone, Debug)]
 pub struct LightBufferBuilder<'a> {
     tris: &'a [Triangle],
+    scene: SceneLeaves,
     source: LightSource,
     options: LightBufferOptions,
     margin: f64,
@@ -57,10 +58,13 @@ pub struct LightBufferFace {
 }
 
 impl<'a> LightBufferBuilder<'a> {
-    /// Checks the scene and the options for a light buffer of `source` over `tris`. Fails on a
-    /// triangle with a NaN or infinite coordinate or on options out of range.
+    /// Checks the scene and the options for a light buffer of `source` over `tris` and `scene`
+    /// (an 8-wide BVH over exactly `tris`, whose leaves the buffer's trees will name). Fails on
+    /// a triangle with a NaN or infinite coordinate, a `scene` over other triangles, or options
+    /// out of range.
     pub fn new(
         tris: &'a [Triangle],
+        scene: &WideBvh8,
         source: LightSource,
         options: &LightBufferOptions,
     ) -> Result<Self, BuildError> {
@@ -89,6 +93,7 @@ impl<'a> LightBufferBuilder<'a> {
             .max_element();
         Ok(Self {
             tris,
+            scene: SceneLeaves::new(scene, tris.len())?,
             source,
             options: *options,
             margin: MARGIN * f64::from(scale).max(f64::from(f32::MIN_POSITIVE)),
@@ -173,6 +178,7 @@ impl<'a> LightBufferBuilder<'a> {
             grid: vec![DARK; FACES * r * r],
             forest: WideBvh8::default(),
             margin: self.margin as f32,
+            scene_size: self.scene.size,
             stats: LightBufferStats::default(),
         };
         let mut seen = [false; FACES];
@@ -285,25 +291,21 @@ fn angle(a: DVec3, b: DVec3) -> f64 {
     libm::atan2(a.cross(b).length(), a.dot(b))
 }
 
-/// Buffers reused by every leaf's tree build: the arena (several KiB of bins, costly to make
-/// afresh for each of a face's hundreds of small trees), the binary tree and the triangles.
+/// What every leaf's tree build reuses ([`CellTreeBuilder`]).
 struct Leaf {
-    local: Vec<Triangle>,
-    arena: BuildArena,
-    bvh: Bvh,
+    tree: CellTreeBuilder,
 }
 
 impl Leaf {
     fn new() -> Self {
         Self {
-            local: Vec::new(),
-            arena: BuildArena::with_capacity(0),
-            bvh: Bvh::default(),
+            tree: CellTreeBuilder::new(),
         }
     }
 
-    /// Makes `task` a leaf: its grid cells name a new tree over the triangles it reaches (boxed
-    /// by their parts inside its region), or [`CLEAR`] when it reaches none.
+    /// Makes `task` a leaf: its grid cells name a new tree over the scene leaves holding the
+    /// triangles it reaches (boxed by their parts inside its region), or [`CLEAR`] when it
+    /// reaches none.
     fn finish(
         &mut self,
         task: &Task,
@@ -311,31 +313,23 @@ impl Leaf {
         out: &mut LightBufferFace,
     ) -> Result<(), BuildError> {
         let region = Region::new(&task.rect, &build.source, build.margin);
-        let arena = &mut self.arena;
-        if arena.capacity() < task.refs.len() {
-            *arena = BuildArena::with_capacity(task.refs.len());
-        } else {
-            arena.clear();
-        }
-        self.local.clear();
-        for &id in &task.refs {
-            let tri = &build.tris[id as usize];
-            if let Some(bounds) = region.clipped_bounds(tri) {
-                arena.push(self.local.len() as u32, bounds)?;
-                self.local.push(*tri);
+        let reached = task.refs.iter().filter_map(|&id| {
+            region
+                .clipped_bounds(&build.tris[id as usize])
+                .map(|bounds| (id, bounds))
+        });
+        let slot = match self.tree.build(reached, &build.scene)? {
+            None => {
+                out.stats.clear_cells += 1;
+                CLEAR
             }
-        }
-        let slot = if self.local.is_empty() {
-            out.stats.clear_cells += 1;
-            CLEAR
-        } else {
-            Builder::sah().for_wide().build_into(arena, &mut self.bvh)?;
-            out.stats.trees += 1;
-            out.stats.references += self.local.len();
-            let mut tree = WideBvh8::from_binary(&self.bvh, &self.local);
-            let light = build.source.bounds.center();
-            tree.order_children(|b| -b.center().distance_squared(light));
-            out.forest.append(&tree).unwrap_or(CLEAR)
+            Some((mut tree, triangles)) => {
+                out.stats.trees += 1;
+                out.stats.references += triangles;
+                let light = build.source.bounds.center();
+                tree.order_children(|b| -b.center().distance_squared(light));
+                out.forest.append(&tree).unwrap_or(CLEAR)
+            }
         };
         let span = 1u32 << (build.options.max_level - task.level);
         let r = build.resolution as usize;

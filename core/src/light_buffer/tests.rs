@@ -7,8 +7,41 @@ use glam::Vec3;
 
 use super::{LightBuffer, LightBufferOptions, LightSource};
 use crate::brute_force;
+use crate::bvh::WideBvh8;
 use crate::geometry::{Ray, Triangle};
 use crate::random::Pcg32;
+use crate::{BuildError, BuildOptions, Preset};
+
+/// A buffer with the scene BVH its trees point into.
+struct Built {
+    buffer: LightBuffer,
+    scene: WideBvh8,
+}
+
+impl Built {
+    fn occluded(&self, ray: &Ray) -> Option<bool> {
+        self.buffer.occluded(&self.scene, ray)
+    }
+}
+
+/// The scene BVH of `tris` (SAH, 8-wide; empty for a scene it cannot build).
+fn scene_of(tris: &[Triangle]) -> WideBvh8 {
+    BuildOptions::new(Preset::Sah)
+        .build(tris, None)
+        .map(|bvh| WideBvh8::from_binary(&bvh, tris))
+        .unwrap_or_default()
+}
+
+/// [`LightBuffer::build`] over `tris` and their scene BVH.
+fn built(
+    tris: &[Triangle],
+    source: LightSource,
+    opts: &LightBufferOptions,
+) -> Result<Built, BuildError> {
+    let scene = scene_of(tris);
+    let buffer = LightBuffer::build(tris, &scene, source, opts)?;
+    Ok(Built { buffer, scene })
+}
 
 /// The thesis's random scene recipe, `n` triangles in `[0, 10]^3`.
 fn soup(n: usize, rng: &mut Pcg32) -> Vec<Triangle> {
@@ -34,7 +67,7 @@ fn shadow(p: Vec3, s: Vec3) -> Ray {
 }
 
 /// Checks `rays` through `buffer` against brute force; returns how many it answered.
-fn check(buffer: &LightBuffer, tris: &[Triangle], rays: &[Ray]) -> usize {
+fn check(buffer: &Built, tris: &[Triangle], rays: &[Ray]) -> usize {
     let mut answered = 0;
     for (i, ray) in rays.iter().enumerate() {
         if let Some(hit) = buffer.occluded(ray) {
@@ -63,7 +96,7 @@ fn point_lights_answer_every_segment_as_brute_force_does() {
         (Vec3::new(-20.0, 3.0, 40.0), options(8, 1)),
         (tris[7].v1, options(5, 4)),
     ] {
-        let buffer = LightBuffer::build(&tris, LightSource::point(light).unwrap(), &opts).unwrap();
+        let buffer = built(&tris, LightSource::point(light).unwrap(), &opts).unwrap();
         let rays: Vec<Ray> = (0..3000)
             .map(|_| shadow(point_in(&mut rng, -1.0, 11.0), light))
             .collect();
@@ -81,8 +114,7 @@ fn face_edges_and_surface_receivers_agree_with_brute_force() {
     let mut rng = Pcg32::new(2);
     let tris = soup(800, &mut rng);
     let light = Vec3::new(5.0, 5.0, 5.0);
-    let buffer =
-        LightBuffer::build(&tris, LightSource::point(light).unwrap(), &options(6, 4)).unwrap();
+    let buffer = built(&tris, LightSource::point(light).unwrap(), &options(6, 4)).unwrap();
     let mut rays = Vec::new();
     for _ in 0..2000 {
         let a = rng.range(-6.0, 6.0);
@@ -118,7 +150,7 @@ fn spot_lights_answer_inside_their_cone() {
     let axis = Vec3::new(0.2, -1.0, 0.1).normalize();
     let half = 0.5f32;
     let source = LightSource::spot(light, axis, half).unwrap();
-    let buffer = LightBuffer::build(&tris, source, &options(6, 8)).unwrap();
+    let buffer = built(&tris, source, &options(6, 8)).unwrap();
     let mut inside = 0;
     let rays: Vec<Ray> = (0..4000)
         .map(|_| {
@@ -134,7 +166,10 @@ fn spot_lights_answer_inside_their_cone() {
         answered >= inside,
         "{answered} answered, {inside} inside the cone"
     );
-    assert!(buffer.stats().dark_cells > 0, "the cone leaves cells dark");
+    assert!(
+        buffer.buffer.stats().dark_cells > 0,
+        "the cone leaves cells dark"
+    );
 }
 
 #[test]
@@ -155,7 +190,7 @@ fn one_sided_quads_and_many_point_lights_agree_with_brute_force() {
         LightSource::polygon(&corners, None).unwrap(),
         LightSource::polygon(&many, Some(normal)).unwrap(),
     ] {
-        let buffer = LightBuffer::build(&tris, source, &options(5, 8)).unwrap();
+        let buffer = built(&tris, source, &options(5, 8)).unwrap();
         let mut front = 0;
         let rays: Vec<Ray> = (0..3000)
             .map(|_| {
@@ -170,7 +205,7 @@ fn one_sided_quads_and_many_point_lights_agree_with_brute_force() {
         let answered = check(&buffer, &tris, &rays);
         assert!(answered >= front, "{answered} answered, {front} in front");
         // Segments that end off the tilted quad but inside its box are answered exactly too.
-        let b = buffer.source().bounds();
+        let b = buffer.buffer.source().bounds();
         let off: Vec<Ray> = (0..3000)
             .map(|_| {
                 let s = b.min
@@ -187,7 +222,7 @@ fn segments_that_do_not_end_on_the_light_are_not_answered() {
     let mut rng = Pcg32::new(5);
     let tris = soup(100, &mut rng);
     let light = Vec3::new(5.0, 5.0, 5.0);
-    let buffer = LightBuffer::build(
+    let buffer = built(
         &tris,
         LightSource::point(light).unwrap(),
         &LightBufferOptions::default(),
@@ -195,7 +230,7 @@ fn segments_that_do_not_end_on_the_light_are_not_answered() {
     .unwrap();
     let ray = Ray::segment(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0), 0.0, 1.0).unwrap();
     assert_eq!(buffer.occluded(&ray), None);
-    let behind = LightBuffer::build(
+    let behind = built(
         &tris,
         LightSource::polygon(&[light, light + Vec3::X, light + Vec3::Z], Some(Vec3::Y)).unwrap(),
         &LightBufferOptions::default(),
@@ -218,15 +253,15 @@ fn bad_sources_and_options_are_errors() {
     assert!(LightSource::polygon(&[Vec3::ZERO], Some(Vec3::ZERO)).is_err());
     let tris = [Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y)];
     let source = LightSource::point(Vec3::Z).unwrap();
-    assert!(LightBuffer::build(&tris, source.clone(), &options(9, 8)).is_err());
+    assert!(built(&tris, source.clone(), &options(9, 8)).is_err());
     let bad = [Triangle::new(
         Vec3::ZERO,
         Vec3::X,
         Vec3::splat(f32::INFINITY),
     )];
-    assert!(LightBuffer::build(&bad, source.clone(), &options(4, 8)).is_err());
+    assert!(built(&bad, source.clone(), &options(4, 8)).is_err());
     // An empty scene: every segment is clear.
-    let empty = LightBuffer::build(&[], source, &options(4, 8)).unwrap();
+    let empty = built(&[], source, &options(4, 8)).unwrap();
     assert_eq!(empty.occluded(&shadow(Vec3::ONE, Vec3::Z)), Some(false));
 }
 
@@ -239,8 +274,8 @@ fn faces_built_apart_make_the_same_buffer() {
     let tris = soup(800, &mut rng);
     let source = LightSource::point(Vec3::new(4.0, 6.0, 5.0)).unwrap();
     let opts = options(5, 8);
-    let whole = LightBuffer::build(&tris, source.clone(), &opts).unwrap();
-    let build = LightBufferBuilder::new(&tris, source.clone(), &opts).unwrap();
+    let whole = built(&tris, source.clone(), &opts).unwrap();
+    let build = LightBufferBuilder::new(&tris, &whole.scene, source.clone(), &opts).unwrap();
     let faces: Vec<_> = (0..LightBufferBuilder::FACES)
         .rev()
         .map(|f| build.face(f).unwrap())
@@ -250,12 +285,15 @@ fn faces_built_apart_make_the_same_buffer() {
     twice[0] = faces[1].clone();
     assert!(build.clone().finish(twice).is_err());
     assert!(build.clone().finish(faces[1..].to_vec()).is_err());
-    let coarse = LightBufferBuilder::new(&tris, source, &options(3, 8)).unwrap();
+    let coarse = LightBufferBuilder::new(&tris, &whole.scene, source, &options(3, 8)).unwrap();
     let mut foreign = faces.clone();
     foreign[2] = coarse.face(LightBufferBuilder::FACES - 3).unwrap();
     assert!(build.clone().finish(foreign).is_err());
-    let apart = build.finish(faces).unwrap();
-    assert_eq!(apart.stats(), whole.stats());
+    let apart = Built {
+        buffer: build.finish(faces).unwrap(),
+        scene: whole.scene.clone(),
+    };
+    assert_eq!(apart.buffer.stats(), whole.buffer.stats());
     let rays: Vec<Ray> = (0..2000)
         .map(|_| shadow(point_in(&mut rng, -1.0, 11.0), Vec3::new(4.0, 6.0, 5.0)))
         .collect();
@@ -263,4 +301,23 @@ fn faces_built_apart_make_the_same_buffer() {
         assert_eq!(apart.occluded(ray), whole.occluded(ray));
     }
     assert_eq!(check(&apart, &tris, &rays), rays.len());
+}
+
+/// A scene BVH over other triangles is an error at build time, and a BVH of another size at
+/// query time gets `None`, never an answer from blocks the buffer does not know.
+#[test]
+fn the_scene_bvh_must_be_the_scenes() {
+    let mut rng = Pcg32::new(13);
+    let tris = soup(300, &mut rng);
+    let source = LightSource::point(Vec3::new(5.0, 8.0, 5.0)).unwrap();
+    let opts = LightBufferOptions::default();
+    let fewer = scene_of(&tris[..200]);
+    assert!(LightBuffer::build(&tris, &fewer, source.clone(), &opts).is_err());
+    let mut doubled = tris.clone();
+    doubled.extend_from_slice(&tris);
+    assert!(LightBuffer::build(&tris, &scene_of(&doubled), source.clone(), &opts).is_err());
+    let b = built(&tris, source, &opts).unwrap();
+    let ray = shadow(Vec3::new(5.0, -1.0, 5.0), Vec3::new(5.0, 8.0, 5.0));
+    assert!(b.occluded(&ray).is_some());
+    assert_eq!(b.buffer.occluded(&scene_of(&tris[..200]), &ray), None);
 }

@@ -8,6 +8,7 @@
 //! global BVH.
 
 use rayon::prelude::*;
+use rdbvh_core::bvh::WideBvh8;
 use rdbvh_core::geometry::{Aabb, Triangle};
 use rdbvh_core::light_buffer::{LightBuffer, LightBufferBuilder, LightBufferOptions, LightSource};
 use rdbvh_core::Vec3;
@@ -38,14 +39,21 @@ pub(super) struct Group {
     pub(super) single: Option<Light>,
 }
 
-/// The light buffers for `lights` over `triangles`, built on the current rayon pool (every face
-/// of every buffer in parallel), and per light the index of its buffer or `NO_BUFFER`.
+/// The light buffers for `lights` over `triangles` and their global BVH `global`, built on the
+/// current rayon pool (every face of every buffer in parallel), and per light the index of its
+/// buffer or `NO_BUFFER`.
 pub(super) fn light_buffers(
     triangles: &[Triangle],
+    global: &WideBvh8,
     lights: &[Light],
 ) -> Result<(Vec<LightBuffer>, Vec<u32>), RenderError> {
     let groups = light_groups(triangles, lights);
-    build_buffers(triangles, &groups.iter().collect::<Vec<_>>(), lights.len())
+    build_buffers(
+        triangles,
+        global,
+        &groups.iter().collect::<Vec<_>>(),
+        lights.len(),
+    )
 }
 
 /// The groups that may get a buffer: every light from the lights file, emissive triangles
@@ -57,10 +65,12 @@ pub(super) fn light_groups(triangles: &[Triangle], lights: &[Light]) -> Vec<Grou
     groups
 }
 
-/// The buffers of `groups`, built on the current rayon pool (every face of every buffer in
+/// The buffers of `groups` over `triangles` and their global BVH `global` (whose leaves the
+/// buffers' trees name), built on the current rayon pool (every face of every buffer in
 /// parallel), and per light (of `light_count`) the index of its buffer or `NO_BUFFER`.
 pub(super) fn build_buffers(
     triangles: &[Triangle],
+    global: &WideBvh8,
     groups: &[&Group],
     light_count: usize,
 ) -> Result<(Vec<LightBuffer>, Vec<u32>), RenderError> {
@@ -72,7 +82,9 @@ pub(super) fn build_buffers(
                 Some(light) => light.source(triangles)?,
                 None => LightSource::polygon(&g.points, None)?,
             };
-            Ok(LightBufferBuilder::new(triangles, source, &options)?)
+            Ok(LightBufferBuilder::new(
+                triangles, global, source, &options,
+            )?)
         })
         .collect::<Result<Vec<_>, RenderError>>()?;
     let faces = (0..builders.len() * LightBufferBuilder::FACES)

@@ -150,7 +150,12 @@ pub fn build_lights(
         })
         .collect();
     let chosen_groups: Vec<_> = chosen.iter().map(|&g| &groups[g]).collect();
-    let (buffers, buffer_of) = build_buffers(triangles, &chosen_groups, lights.lights().len())?;
+    let (buffers, buffer_of) = build_buffers(
+        triangles,
+        structure.global(),
+        &chosen_groups,
+        lights.lights().len(),
+    )?;
     structure.install_buffers(buffers, buffer_of);
     let keep: Vec<bool> = chosen
         .iter()

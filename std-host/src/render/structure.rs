@@ -85,7 +85,7 @@ impl Structure {
             StructureKind::Global | StructureKind::Thesis => {
                 (Vec::new(), vec![NO_BUFFER; lights.len()])
             }
-            StructureKind::Lights => light_buffers(triangles, lights)?,
+            StructureKind::Lights => light_buffers(triangles, &global, lights)?,
         };
         let thesis = match kind {
             StructureKind::Thesis => Some(ThesisStructure::build(
@@ -199,7 +199,7 @@ impl Structure {
         }
         let buffer = self.buffer_of[light];
         if buffer != NO_BUFFER {
-            if let Some(answer) = self.buffers[buffer as usize].occluded(ray) {
+            if let Some(answer) = self.buffers[buffer as usize].occluded(&self.global, ray) {
                 return answer;
             }
         }
@@ -215,7 +215,8 @@ impl Structure {
         }
         let buffer = self.buffer_of[light];
         if buffer != NO_BUFFER {
-            if let Some(answer) = self.buffers[buffer as usize].occluded_with_stats(ray, stats) {
+            let buffer = &self.buffers[buffer as usize];
+            if let Some(answer) = buffer.occluded_with_stats(&self.global, ray, stats) {
                 return answer;
             }
         }

@@ -572,12 +572,16 @@ where
         if self.nodes.is_empty() || self.misses_root(ray) {
             return false;
         }
-        self.any_dispatched(0, &self.tris, ray, stats)
+        self.any_hit_from(0, &self.tris, ray, stats)
     }
 
-    /// [`WideBvh::any_from_root`], through the AVX2 entry point where the CPU has it.
+    /// [`WideBvh::any_hit_with_stats`] from node `root` of a forest ([`WideBvh::append`]) whose
+    /// leaves name blocks of `tris` (its own, or another tree's: a light buffer's cell trees
+    /// point into the scene BVH's blocks), with no root-box test: a tree the caller chose for
+    /// the ray. Runs [`WideBvh::any_from_root`], through the AVX2 entry point where the CPU has
+    /// it.
     #[inline(always)]
-    fn any_dispatched(
+    pub(crate) fn any_hit_from(
         &self,
         root: u32,
         tris: &[Triangle4],
@@ -590,21 +594,6 @@ where
             return unsafe { super::avx2::any(self, root, tris, ray, stats) };
         }
         self.any_from_root(root, tris, ray, stats)
-    }
-
-    /// [`WideBvh::any_hit_with_stats`] from node `root` of a forest ([`WideBvh::append`]) whose
-    /// leaves name blocks of `tris` (its own, or another tree's: a light buffer's cell trees
-    /// point into the scene BVH's blocks), with no root-box test: a tree the caller chose for
-    /// the ray.
-    #[inline]
-    pub(crate) fn any_hit_from(
-        &self,
-        root: u32,
-        tris: &[Triangle4],
-        ray: &Ray,
-        stats: &mut impl Counters,
-    ) -> bool {
-        self.any_dispatched(root, tris, ray, stats)
     }
 
     /// The any-hit traversal proper from node `root`, out of line (see

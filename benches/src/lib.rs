@@ -82,6 +82,18 @@ pub fn load_scene(name: &str) -> Result<Vec<Triangle>, String> {
     Ok(scene.triangles)
 }
 
+/// A scene named on a command line: a path (or a built-in scene such as `builtin:room`) is opened
+/// as given, a bare name is one of `../shared`'s scenes ([`load_scene`]).
+pub fn open_scene(scene: &str) -> Result<Vec<Triangle>, String> {
+    let named = !scene.contains('/') && !scene.contains(':') && !scene.ends_with(".obj");
+    if named {
+        return load_scene(scene);
+    }
+    rdbvh::scene::Scene::open(scene)
+        .map(|s| s.triangles)
+        .map_err(|e| format!("cannot load {scene}: {e}"))
+}
+
 /// The bounds of `tris`.
 pub fn bounds(tris: &[Triangle]) -> Aabb {
     tris.iter().fold(Aabb::EMPTY, |b, t| b.union(t.bounds()))

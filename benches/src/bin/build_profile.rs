@@ -25,7 +25,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use rdbvh_benches::compare::{plane_area_over, point_area_over};
-use rdbvh_benches::{load_scene, thread_cpu_seconds};
+use rdbvh_benches::{open_scene, thread_cpu_seconds};
 use rdbvh_core::builder::{BuildArena, BuildOptions, Builder, Preset, PresetError, PresetOptions};
 use rdbvh_core::bvh::Bvh;
 use rdbvh_core::geometry::Triangle;
@@ -127,16 +127,7 @@ fn main() -> ExitCode {
             }
         }
     };
-    // A path (or a built-in scene) is opened as given; a bare name is one of ../shared's scenes.
-    let named = !scene.contains('/') && !scene.contains(':') && !scene.ends_with(".obj");
-    let loaded = if named {
-        load_scene(&scene)
-    } else {
-        rdbvh::scene::Scene::open(&scene)
-            .map(|s| s.triangles)
-            .map_err(|e| format!("cannot load {scene}: {e}"))
-    };
-    let tris = match loaded {
+    let tris = match open_scene(&scene) {
         Ok(t) => t,
         Err(e) => {
             eprintln!("error: {e}");

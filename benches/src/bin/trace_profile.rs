@@ -12,7 +12,7 @@ use std::hint::black_box;
 use std::process::ExitCode;
 
 use rdbvh_benches::peers::{Library, Prepared, RdbvhWide, RdbvhWide8};
-use rdbvh_benches::{bounds, load_scene, ray_set, thread_cpu_seconds, RayKind};
+use rdbvh_benches::{bounds, open_scene, ray_set, thread_cpu_seconds, RayKind};
 use rdbvh_core::geometry::{Ray, Triangle};
 
 const MEASURES: [(&str, RayKind, bool); 4] = [
@@ -61,7 +61,7 @@ fn main() -> ExitCode {
         return ExitCode::FAILURE;
     };
     let reps: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(7);
-    let tris = match load_scene(scene) {
+    let tris = match open_scene(scene) {
         Ok(t) => t,
         Err(e) => {
             eprintln!("error: {e}");

@@ -148,7 +148,8 @@ impl<const W: usize> WideBvhN<W> {
     /// that costs less than opening it, and a larger binary leaf a leaf of consecutive blocks.
     /// Depth never grows. Ids missing from `tris` are dropped, as the binary traversal skips them.
     ///
-    /// Each node's children come fewest triangles first ([`WideBvhN::order_fewest_first`]).
+    /// Each node's children come fewest triangles first, a leaf before an inner child of as
+    /// many, so that an any-hit query tries the cheap subtrees before a large one.
     pub fn from_binary(bvh: &Bvh, tris: &[Triangle]) -> Self {
         let mut out = Self::collapse(bvh, tris);
         out.order_fewest_first();

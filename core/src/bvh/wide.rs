@@ -272,14 +272,13 @@ impl<const W: usize> WideBvhN<W> {
 
     /// Reorders every node's children so that the one holding the fewest triangles comes first,
     /// a leaf before an inner child of as many, ties in their collapse order. An any-hit query
-    /// (and the all-hit count) descends first into the lowest slot the ray hits, and a small
-    /// subtree is cheap to search, so a shadow ray tries the cheap children before it commits
-    /// to a large one: on the benches' any-hit rays this cut Sponza's node visits by a tenth to
-    /// a quarter (benches/RESULTS.md). Closest-hit queries order by distance; their answers, and
-    /// every answer, do not change.
+    /// descends first into the lowest slot the ray hits, and a small subtree is cheap to search,
+    /// so a shadow ray tries the cheap children before it commits to a large one: on the
+    /// benches' any-hit rays this cut Sponza's node visits by a tenth to a quarter
+    /// (benches/RESULTS.md). Closest-hit queries order by distance; no answer changes.
     pub(crate) fn order_fewest_first(&mut self) {
-        // Children always follow their parent in `nodes` (the collapse and `append` both push
-        // a node before its children), so one backward pass sizes every subtree.
+        // The collapse pushes every node before its children, so one backward pass over `nodes`
+        // sizes every subtree.
         let mut triangles = alloc::vec![0u64; self.nodes.len()];
         for (i, node) in self.nodes.iter().enumerate().rev() {
             triangles[i] = (0..W)

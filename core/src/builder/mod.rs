@@ -22,6 +22,7 @@ mod preset;
 mod profile;
 mod reinsert;
 mod skeleton;
+mod spatial;
 mod sweep;
 
 pub use arena::{BuildArena, LoadedBounds, TriangleLoad};
@@ -33,3 +34,4 @@ pub use preset::{Preset, PresetError, PresetOptions, PresetVisitor};
 pub use profile::{Clock, NoClock, PhaseProfile};
 pub use reinsert::{reinsert, ReinsertConfig, ReinsertStats, Reinserter};
 pub use skeleton::{BuildStats, Builder, Subtree, SubtreeSink};
+pub use spatial::{SpatialBuilder, SpatialSplits};

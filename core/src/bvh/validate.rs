@@ -23,7 +23,8 @@ pub enum InvariantError {
         /// The leaf.
         node: u32,
     },
-    /// A primitive id is missing from the leaves, or appears in more than one place.
+    /// A primitive id is missing from the leaves, or appears in more than one place (for
+    /// [`Bvh::validate_split`]: twice in one leaf).
     PrimitiveCount {
         /// The primitive id.
         prim: u32,
@@ -54,7 +55,10 @@ impl fmt::Display for InvariantError {
                 write!(f, "leaf {node} refers outside the primitive indices")
             }
             InvariantError::PrimitiveCount { prim } => {
-                write!(f, "primitive {prim} is not in exactly one leaf")
+                write!(
+                    f,
+                    "primitive {prim} is missing from the leaves or named too often"
+                )
             }
             InvariantError::ChildOutsideParent { node } => {
                 write!(f, "node {node}'s box is not inside its parent's")
@@ -69,6 +73,16 @@ impl fmt::Display for InvariantError {
 
 impl core::error::Error for InvariantError {}
 
+/// How often a leaf may name a primitive, and what its box must do with the primitive's.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum References {
+    /// Each id in exactly one leaf, its box inside the leaf's (object splits).
+    WholeOnce,
+    /// Each id in at least one leaf and at most once per leaf, its box overlapping the leaf's
+    /// (spatial splits: a leaf bounds only its part of the triangle).
+    Parts,
+}
+
 impl Bvh {
     /// Checks every invariant for a BVH built over primitive ids `0..prim_count` whose boxes
     /// `prim_bounds(id)` returns: each id in exactly one leaf, children in range and reached once,
@@ -78,6 +92,27 @@ impl Bvh {
         &self,
         prim_count: usize,
         prim_bounds: impl Fn(u32) -> crate::geometry::Aabb,
+    ) -> Result<(), InvariantError> {
+        self.walk(prim_count, prim_bounds, References::WholeOnce)
+    }
+
+    /// [`Bvh::validate`] for a tree whose primitives may be split across leaves
+    /// ([`crate::builder::SpatialBuilder`]): each id in at least one leaf and at most once in
+    /// any leaf, every primitive box overlapping its leaf's box, and the same structural
+    /// invariants.
+    pub fn validate_split(
+        &self,
+        prim_count: usize,
+        prim_bounds: impl Fn(u32) -> crate::geometry::Aabb,
+    ) -> Result<(), InvariantError> {
+        self.walk(prim_count, prim_bounds, References::Parts)
+    }
+
+    fn walk(
+        &self,
+        prim_count: usize,
+        prim_bounds: impl Fn(u32) -> crate::geometry::Aabb,
+        references: References,
     ) -> Result<(), InvariantError> {
         if self.nodes.is_empty() {
             return match prim_count {
@@ -101,13 +136,21 @@ impl Bvh {
                     .prim_indices
                     .get(first..first + node.count as usize)
                     .ok_or(InvariantError::BadLeafRange { node: index })?;
-                for &prim in run {
+                for (i, &prim) in run.iter().enumerate() {
                     let slot = seen_prim
                         .get_mut(prim as usize)
                         .ok_or(InvariantError::PrimitiveCount { prim })?;
                     *slot += 1;
-                    if !bounds.contains_box(&prim_bounds(prim)) {
+                    let b = prim_bounds(prim);
+                    let inside = match references {
+                        References::WholeOnce => bounds.contains_box(&b),
+                        References::Parts => !bounds.intersection(b).is_empty(),
+                    };
+                    if !inside {
                         return Err(InvariantError::PrimitiveOutsideLeaf { node: index });
+                    }
+                    if references == References::Parts && run[..i].contains(&prim) {
+                        return Err(InvariantError::PrimitiveCount { prim });
                     }
                 }
             } else {
@@ -129,10 +172,14 @@ impl Bvh {
         if let Some(node) = seen_node.iter().position(|&s| !s) {
             return Err(InvariantError::Unreachable { node: node as u32 });
         }
-        if let Some(prim) = seen_prim.iter().position(|&c| c != 1) {
+        let miscounted = |c: u32| match references {
+            References::WholeOnce => c != 1,
+            References::Parts => c == 0,
+        };
+        if let Some(prim) = seen_prim.iter().position(|&c| miscounted(c)) {
             return Err(InvariantError::PrimitiveCount { prim: prim as u32 });
         }
-        if self.prim_indices.len() != prim_count {
+        if references == References::WholeOnce && self.prim_indices.len() != prim_count {
             return Err(InvariantError::PrimitiveCount {
                 prim: prim_count as u32,
             });

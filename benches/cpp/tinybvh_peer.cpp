@@ -1,7 +1,7 @@
 // tinybvh (the single header shipped in the tinybvh-rs crate) behind a small C ABI for the
-// `peers` comparison: builds of BVH8_CPU and BVH4_CPU with or without tinybvh's threaded
-// builder, and the two queries, one ray at a time. Compiled by benches/build.rs with
-// -O3 -march=native (tinybvh's BVH8_CPU needs AVX2 and FMA).
+// `peers` comparison: builds of BVH8_CPU and BVH4_CPU by `Build` or `BuildHQ` (spatial splits),
+// with or without tinybvh's threaded builder, and the two queries, one ray at a time. Compiled
+// by benches/build.rs with -O3 -march=native (tinybvh's BVH8_CPU needs AVX2 and FMA).
 #define TINYBVH_IMPLEMENTATION
 #include "tiny_bvh.h"
 
@@ -18,12 +18,20 @@ tinybvh::BVH& inner_of(tinybvh::BVH8_CPU& b) { return b.bvh8.bvh; }
 tinybvh::BVH& inner_of(tinybvh::BVH4_CPU& b) { return b.bvh4.bvh; }
 
 template <typename B>
-void* build_layout(const float* verts, uint32_t tris, bool threaded) {
+void* build_layout(const float* verts, uint32_t tris, bool threaded, bool hq) {
     B* b = new (std::nothrow) B();
     if (!b) return nullptr;
-    // Cleared before the build: tinybvh clears it itself under 50k triangles, never sets it.
+    // Cleared before the build: tinybvh clears it itself under 50k triangles, never sets it
+    // (in either builder).
     inner_of(*b).threadedBuild = threaded;
-    b->Build(reinterpret_cast<const bvhvec4*>(verts), tris);
+    const bvhvec4* v = reinterpret_cast<const bvhvec4*>(verts);
+    // BuildHQ differs from Build only in the binary builder (the SBVH one); the leaf regrouping
+    // and the collapse into the layout are the same.
+    if (hq) {
+        b->BuildHQ(v, tris);
+    } else {
+        b->Build(v, tris);
+    }
     return b;
 }
 
@@ -53,10 +61,10 @@ void rdbvh_tinybvh_ray(const float* o, const float* d, float t, void* out) {
     new (out) tinybvh::Ray(bvhvec3(o[0], o[1], o[2]), bvhvec3(d[0], d[1], d[2]), t);
 }
 
-// `verts`: 3 * tris vertices of 4 floats each (x, y, z, unused), 16-byte aligned. Null when
-// out of memory.
-void* rdbvh_tinybvh8_build(const float* verts, uint32_t tris, bool threaded) {
-    return build_layout<tinybvh::BVH8_CPU>(verts, tris, threaded);
+// `verts`: 3 * tris vertices of 4 floats each (x, y, z, unused), 16-byte aligned; `hq`:
+// BuildHQ instead of Build. Null when out of memory.
+void* rdbvh_tinybvh8_build(const float* verts, uint32_t tris, bool threaded, bool hq) {
+    return build_layout<tinybvh::BVH8_CPU>(verts, tris, threaded, hq);
 }
 void rdbvh_tinybvh8_free(void* b) { delete static_cast<tinybvh::BVH8_CPU*>(b); }
 // The hit distance along the unit direction, or the ray's own `t` (its segment end) on a miss.
@@ -67,8 +75,8 @@ bool rdbvh_tinybvh8_occluded(const void* b, const void* ray) {
     return occluded<tinybvh::BVH8_CPU>(b, static_cast<const tinybvh::Ray*>(ray));
 }
 
-void* rdbvh_tinybvh4_build(const float* verts, uint32_t tris, bool threaded) {
-    return build_layout<tinybvh::BVH4_CPU>(verts, tris, threaded);
+void* rdbvh_tinybvh4_build(const float* verts, uint32_t tris, bool threaded, bool hq) {
+    return build_layout<tinybvh::BVH4_CPU>(verts, tris, threaded, hq);
 }
 void rdbvh_tinybvh4_free(void* b) { delete static_cast<tinybvh::BVH4_CPU*>(b); }
 float rdbvh_tinybvh4_closest(const void* b, const void* ray) {

@@ -1,6 +1,7 @@
 //! The peer comparison behind the `peers` binary: one scene, the same triangles and the same rays
 //! for rdbvh (binary, 4-wide and 8-wide), obvhs 0.4, bvh 0.13 and parry3d 0.31, and with the `cpp-peers`
-//! feature Embree 3; single-threaded and threaded builds, closest hit on camera and random rays,
+//! feature Embree 3 and tinybvh (each by its default build and by its spatial-split build);
+//! single-threaded and threaded builds, closest hit on camera and random rays,
 //! any hit on random rays and on shadow segments ([`crate::shadow_rays`]); every library's
 //! answers (closest and any hit, on all three ray sets, for the trees of both of its builds)
 //! checked against rdbvh's before any number is reported.
@@ -62,6 +63,8 @@ pub const LIBRARIES: &[&str] = &[
     "parry3d",
     "embree",
     "tinybvh",
+    "embree-high",
+    "tinybvh8-hq",
 ];
 
 /// What is measured.
@@ -566,7 +569,7 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
     let mut bvh = check::<BvhCrate>(tris, &sets, &one, &all)?;
     let mut parry = check::<Parry>(tris, &sets, &one, &all)?;
     #[cfg(feature = "cpp-peers")]
-    let (mut embree, mut tiny8, mut tiny4) = {
+    let (mut embree, mut tiny8, mut tiny4, mut embree_high, mut tiny8_hq) = {
         crate::peers::embree::available()?;
         crate::peers::tinybvh::available()?;
         if u32::try_from(3 * tris.len()).is_err() {
@@ -579,6 +582,8 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
             check::<crate::peers::Embree>(tris, &sets, &one, &all)?,
             check::<crate::peers::TinybvhBvh8>(tris, &sets, &one, &all)?,
             check::<crate::peers::TinybvhBvh4>(tris, &sets, &one, &all)?,
+            check::<crate::peers::EmbreeHigh>(tris, &sets, &one, &all)?,
+            check::<crate::peers::TinybvhBvh8Hq>(tris, &sets, &one, &all)?,
         )
     };
     let mut top = SerialTop::new(tris, all.current_num_threads());
@@ -595,6 +600,8 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         &mut embree as &mut dyn Reps,
         &mut tiny8 as &mut dyn Reps,
         &mut tiny4 as &mut dyn Reps,
+        &mut embree_high as &mut dyn Reps,
+        &mut tiny8_hq as &mut dyn Reps,
     ]);
     // The C++ peers come after the serial top, so the PAH builds are always last.
     let cpp_entries = entries.len() - 8;
@@ -613,7 +620,13 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         parry.run(&t[6]),
     ];
     #[cfg(feature = "cpp-peers")]
-    runs.extend([embree.run(&t[8]), tiny8.run(&t[9]), tiny4.run(&t[10])]);
+    runs.extend([
+        embree.run(&t[8]),
+        tiny8.run(&t[9]),
+        tiny4.run(&t[10]),
+        embree_high.run(&t[11]),
+        tiny8_hq.run(&t[12]),
+    ]);
     let serial_top = (t[7][0], t[7][1]);
     let pah = t.get(8 + cpp_entries).map(|p| PahBuilds {
         sah: p[0],
@@ -878,6 +891,12 @@ impl Report {
                 "tinybvh: its default Build (binned SAH) into BVH8_CPU or BVH4_CPU, each measure \
                  the faster layout: {}",
                 tinybvh.join(", ")
+            );
+            let _ = writeln!(
+                w,
+                "embree-high, tinybvh8-hq: their spatial-split builds (Embree's \
+                 RTC_BUILD_QUALITY_HIGH, where embree is its default MEDIUM; tinybvh's BuildHQ \
+                 into BVH8_CPU)"
             );
         }
         for r in &self.runs {

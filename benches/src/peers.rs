@@ -29,7 +29,10 @@
 //!   `TriMesh::cast_local_ray` takes. Any hit uses `Bvh::traverse` with an early exit on the
 //!   first triangle hit, since parry's composite any-hit query is a full closest-hit cast.
 //!   Segments end at the ray's `t_max` (parry's `max_time_of_impact`).
-//! - **Embree 3** and **tinybvh 1.6.8** (feature `cpp-peers`): see `embree` and `tinybvh`.
+//! - **Embree 3** and **tinybvh 1.6.8** (feature `cpp-peers`): see `embree` and `tinybvh`. Each
+//!   is measured with its default build and beside it with its spatial-split build
+//!   (`embree-high`, `tinybvh8-hq`): a spatial-split (SBVH) build of rdbvh is compared with
+//!   those, not with trees built without splits.
 
 use glam::{Vec3, Vec3A};
 use rdbvh_core::builder::{reinsert, Builder, ReinsertConfig};
@@ -41,11 +44,11 @@ use crate::Answers;
 #[cfg(feature = "cpp-peers")]
 pub mod embree;
 #[cfg(feature = "cpp-peers")]
-pub use embree::Embree;
+pub use embree::{Embree, EmbreeHigh};
 #[cfg(feature = "cpp-peers")]
 pub mod tinybvh;
 #[cfg(feature = "cpp-peers")]
-pub use tinybvh::{TinybvhBvh4, TinybvhBvh8};
+pub use tinybvh::{TinybvhBvh4, TinybvhBvh8, TinybvhBvh8Hq};
 
 /// A library under test: how it takes triangles and rays, builds, and answers the two queries.
 pub trait Library {

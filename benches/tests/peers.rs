@@ -118,7 +118,9 @@ fn bad_input_is_one_error_line() {
 #[cfg(feature = "cpp-peers")]
 #[test]
 fn cpp_peers_agree_with_brute_force_and_rdbvh() {
-    use rdbvh_benches::peers::{Embree, Library, Prepared, TinybvhBvh4, TinybvhBvh8};
+    use rdbvh_benches::peers::{
+        Embree, EmbreeHigh, Library, Prepared, TinybvhBvh4, TinybvhBvh8, TinybvhBvh8Hq,
+    };
     use rdbvh_benches::{agreement, bounds, ray_set, Answers, RayKind};
 
     rdbvh_benches::peers::embree::available().expect("Embree 3 is installed");
@@ -168,9 +170,19 @@ fn cpp_peers_agree_with_brute_force_and_rdbvh() {
         check::<Embree>(tris, &rays, &brute, kind);
         check::<TinybvhBvh8>(tris, &rays, &brute, kind);
         check::<TinybvhBvh4>(tris, &rays, &brute, kind);
+        // The spatial-split builds reference a triangle from several leaves: the answers must
+        // not change.
+        check::<EmbreeHigh>(tris, &rays, &brute, kind);
+        check::<TinybvhBvh8Hq>(tris, &rays, &brute, kind);
     }
     let report = rdbvh_benches::compare::run("builtin:random1000", tris, &quick()).expect("runs");
-    for name in ["embree", "tinybvh-bvh8", "tinybvh-bvh4"] {
+    for name in [
+        "embree",
+        "tinybvh-bvh8",
+        "tinybvh-bvh4",
+        "embree-high",
+        "tinybvh8-hq",
+    ] {
         let r = report
             .runs
             .iter()

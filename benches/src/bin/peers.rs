@@ -1,6 +1,8 @@
 //! `peers SCENE.obj [--json] [--wall]`: rdbvh beside obvhs 0.4, bvh 0.13 and parry3d 0.31 (and,
-//! built with `--features cpp-peers`, Embree 3) on the same triangles and rays (see `rdbvh_benches::compare`). Bad input prints one `error: ...`
-//! line and exits with status 1.
+//! built with `--features cpp-peers`, Embree 3 and tinybvh, each by its default and by its
+//! spatial-split build: `embree`, `embree-high`, `tinybvh`, `tinybvh8-hq`) on the same triangles
+//! and rays (see `rdbvh_benches::compare`). Bad input prints one `error: ...` line and exits with
+//! status 1.
 
 use std::process::ExitCode;
 

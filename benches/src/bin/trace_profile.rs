@@ -1,13 +1,17 @@
 //! `trace_profile SCENE [REPS]`: the four traversal measures of the `peers` table for
-//! `rdbvh-wide` and its 8-wide tree `rdbvh-wide8` alone (with `--features cpp-peers`, Embree's and tinybvh's BVH8 beside it), in
-//! interleaved rounds, best thread CPU time of `REPS` (default 7): a quick before/after check of
-//! the traversal kernel that builds in `release` and skips the builds and the Rust peers. SCENE is
-//! a name under `../shared/scenes` or a path to an OBJ file.
+//! `rdbvh-wide` and its 8-wide tree `rdbvh-wide8` alone (with `--features cpp-peers`, Embree's
+//! and tinybvh's BVH8 beside them, each by its default build and by its spatial-split build,
+//! `embree-high` and `tinybvh8-hq`), in interleaved rounds, best thread CPU time of `REPS`
+//! (default 7): a quick before/after check of the traversal kernel that builds in `release` and
+//! skips the builds and the Rust peers. SCENE is a name under `../shared/scenes` or a path to an
+//! OBJ file. rdbvh's ratios are over the faster of the C++ default builds, which like rdbvh's
+//! SAH build split no triangles.
 //!
 //! `RDBVH_PROFILE_ONLY=closest_camera` (or `closest_random`, `any_random`, `any_shadow`) runs that
 //! measure alone, once per round, inside `trace_profile::trace_once`, for
 //! `valgrind --tool=callgrind --toggle-collect=trace_profile::trace_once`.
 
+use std::fmt::Write as _;
 use std::hint::black_box;
 use std::process::ExitCode;
 
@@ -35,14 +39,49 @@ impl<L: Library> Traced<L> {
             rays: sets.iter().map(|s| L::rays(s)).collect(),
         }
     }
+}
 
+/// A traced library whatever its type, so the C++ peers can be one list.
+trait Timed {
     /// Seconds of thread CPU time and hits for measure `m`.
+    fn time(&self, m: usize) -> (f64, usize);
+}
+
+impl<L: Library> Timed for Traced<L> {
     fn time(&self, m: usize) -> (f64, usize) {
         let start = thread_cpu_seconds();
         let hits = trace_once(&self.prepared, &self.rays[m], MEASURES[m].2);
         (thread_cpu_seconds() - start, hits)
     }
 }
+
+/// The C++ peers with their names in the table: first the two default builds (the ratios'
+/// base), then the two spatial-split builds.
+#[cfg(feature = "cpp-peers")]
+fn cpp_peers(tris: &[Triangle], sets: &[Vec<Ray>]) -> Vec<(&'static str, Box<dyn Timed>)> {
+    use rdbvh_benches::peers::{Embree, EmbreeHigh, TinybvhBvh8, TinybvhBvh8Hq};
+    vec![
+        ("embree", Box::new(Traced::<Embree>::new(tris, sets))),
+        ("tinybvh8", Box::new(Traced::<TinybvhBvh8>::new(tris, sets))),
+        (
+            "embree-high",
+            Box::new(Traced::<EmbreeHigh>::new(tris, sets)),
+        ),
+        (
+            "tinybvh8-hq",
+            Box::new(Traced::<TinybvhBvh8Hq>::new(tris, sets)),
+        ),
+    ]
+}
+
+/// Without the C++ peers: none.
+#[cfg(not(feature = "cpp-peers"))]
+fn cpp_peers(_: &[Triangle], _: &[Vec<Ray>]) -> Vec<(&'static str, Box<dyn Timed>)> {
+    Vec::new()
+}
+
+/// How many of [`cpp_peers`] are default builds, the base of rdbvh's ratios.
+const DEFAULT_BUILDS: usize = 2;
 
 /// One pass over a ray set: the timed (and, under callgrind, the counted) work.
 #[inline(never)]
@@ -79,63 +118,61 @@ fn main() -> ExitCode {
         .collect();
     let wide = Traced::<RdbvhWide>::new(&tris, &sets);
     let wide8 = Traced::<RdbvhWide8>::new(&tris, &sets);
-    #[cfg(feature = "cpp-peers")]
-    let embree = Traced::<rdbvh_benches::peers::Embree>::new(&tris, &sets);
-    #[cfg(feature = "cpp-peers")]
-    let tiny = Traced::<rdbvh_benches::peers::TinybvhBvh8>::new(&tris, &sets);
-    let mut best = vec![[f64::INFINITY; 4]; MEASURES.len()];
+    let peers = cpp_peers(&tris, &sets);
+    // Per measure: rdbvh-wide, rdbvh-wide8, then each C++ peer.
+    let mut best = vec![vec![f64::INFINITY; 2 + peers.len()]; MEASURES.len()];
+    let mut peer_hits = vec![0; peers.len()];
     for _ in 0..reps {
         for &m in &chosen {
             let (t, hits) = wide.time(m);
             best[m][0] = best[m][0].min(t);
             let (t8, hits8) = wide8.time(m);
-            best[m][3] = best[m][3].min(t8);
+            best[m][1] = best[m][1].min(t8);
             if hits8 != hits {
                 eprintln!("{}: hits {hits} 4-wide, {hits8} 8-wide", MEASURES[m].0);
                 return ExitCode::FAILURE;
             }
-            #[cfg(feature = "cpp-peers")]
-            {
-                let (te, he) = embree.time(m);
-                let (tt, ht) = tiny.time(m);
-                best[m][1] = best[m][1].min(te);
-                best[m][2] = best[m][2].min(tt);
-                // Shared-edge rays may differ by a few; a large gap means a broken kernel.
-                if hits.abs_diff(he) * 1000 > hits || hits.abs_diff(ht) * 1000 > hits {
-                    eprintln!(
-                        "{}: hits {hits} vs embree {he}, tinybvh {ht}",
-                        MEASURES[m].0
-                    );
-                    return ExitCode::FAILURE;
-                }
+            for (i, (_, peer)) in peers.iter().enumerate() {
+                let (tp, hp) = peer.time(m);
+                best[m][2 + i] = best[m][2 + i].min(tp);
+                peer_hits[i] = hp;
             }
-            let _ = hits;
+            // Shared-edge rays may differ by a few; a large gap means a broken kernel.
+            if peer_hits.iter().any(|&h| hits.abs_diff(h) * 1000 > hits) {
+                let each: Vec<String> = peers
+                    .iter()
+                    .zip(&peer_hits)
+                    .map(|((name, _), h)| format!("{name} {h}"))
+                    .collect();
+                eprintln!("{}: hits {hits} vs {}", MEASURES[m].0, each.join(", "));
+                return ExitCode::FAILURE;
+            }
         }
     }
     println!("{scene}: Mrays/s, best of {reps} (thread CPU time)");
     for &m in &chosen {
         let n = sets[m].len() as f64;
         let rate = |t: f64| n / t * 1e-6;
-        let [w, e, t, w8] = best[m];
-        if e.is_finite() {
-            println!(
-                "{:<15} wide {:>6.2} ({:.2}x)  wide8 {:>6.2} ({:.2}x)  embree {:>6.2}  tinybvh8 {:>6.2}",
-                MEASURES[m].0,
-                rate(w),
-                rate(w) / rate(e).max(rate(t)),
-                rate(w8),
-                rate(w8) / rate(e).max(rate(t)),
-                rate(e),
-                rate(t),
-            );
+        let (w, w8) = (rate(best[m][0]), rate(best[m][1]));
+        let mut line = format!("{:<15} wide {w:>6.2}", MEASURES[m].0);
+        if peers.is_empty() {
+            let _ = write!(line, "  wide8 {w8:>6.2}");
         } else {
-            println!(
-                "{:<15} wide {:>6.2}  wide8 {:>6.2}",
-                MEASURES[m].0,
-                rate(w),
-                rate(w8)
+            let base = best[m][2..2 + DEFAULT_BUILDS]
+                .iter()
+                .map(|&t| rate(t))
+                .fold(0.0, f64::max);
+            let _ = write!(
+                line,
+                " ({:.2}x)  wide8 {w8:>6.2} ({:.2}x)",
+                w / base,
+                w8 / base
             );
+            for (i, (name, _)) in peers.iter().enumerate() {
+                let _ = write!(line, "  {name} {:>6.2}", rate(best[m][2 + i]));
+            }
         }
+        println!("{line}");
     }
     ExitCode::SUCCESS
 }

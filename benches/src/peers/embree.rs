@@ -2,10 +2,14 @@
 //! anchor renderers measure against.
 //!
 //! - **Build**: one triangle mesh over the scene's vertices (shared with Embree, not copied: a
-//!   renderer hands Embree its own buffers), the scene's default build quality (`MEDIUM`: binned
-//!   SAH, no spatial splits, the high-quality build off) and default flags (not `ROBUST`, not
-//!   `COMPACT`). Embree picks its widest kernels at run time (AVX-512 where the CPU has it, 8-wide
-//!   nodes on AVX and up).
+//!   renderer hands Embree its own buffers) and default flags (not `ROBUST`, not `COMPACT`).
+//!   Embree picks its widest kernels at run time (AVX-512 where the CPU has it, 8-wide nodes on
+//!   AVX and up).
+//! - **Build quality**: measured twice. `embree` keeps the scene's default quality (`MEDIUM`:
+//!   binned SAH, no spatial splits), what a renderer gets without asking. `embree-high` sets
+//!   `RTC_BUILD_QUALITY_HIGH`, which for triangle meshes selects Embree's spatial-split SAH
+//!   builder (its "final-frame" quality), the like of a spatial-split build of rdbvh.
+//!   Both trees are traced by the same kernels.
 //! - **One thread**: the build device is created with `threads=1`. Embree runs its builds on TBB,
 //!   and `threads=1` caps TBB's whole process at one thread (`tbb::global_control`), so the build
 //!   runs on the calling thread and its thread CPU time is the build's. `build_mt` creates a
@@ -119,8 +123,8 @@ impl Drop for EmbreeAccel {
     }
 }
 
-/// Builds the scene over `s`'s buffers on `device`.
-fn build_on(device: &Device, s: &EmbreeScene) -> EmbreeAccel {
+/// Builds the scene over `s`'s buffers on `device`, with build quality `quality`.
+fn build_on(device: &Device, s: &EmbreeScene, quality: sys::RTCBuildQuality) -> EmbreeAccel {
     let tris = s.indices.len() / 3;
     // SAFETY: the device is live; the shared buffers outlive the scene for as long as it is
     // traced (the accel is used only beside the `EmbreeScene` it was built from, which the
@@ -128,6 +132,7 @@ fn build_on(device: &Device, s: &EmbreeScene) -> EmbreeAccel {
     // here, and the vertex buffer carries the padding Embree's 16-byte loads need.
     unsafe {
         let scene = sys::rtcNewScene(device.0);
+        sys::rtcSetSceneBuildQuality(scene, quality);
         let geom = sys::rtcNewGeometry(device.0, sys::RTCGeometryType::TRIANGLE);
         sys::rtcSetSharedGeometryBuffer(
             geom,
@@ -157,24 +162,35 @@ fn build_on(device: &Device, s: &EmbreeScene) -> EmbreeAccel {
     }
 }
 
-/// Embree 3's default build, traced one ray at a time.
-pub struct Embree;
-
-impl Embree {
-    /// A built tree, or the error Embree reported while building it.
-    fn checked(device: &Device, accel: EmbreeAccel) -> EmbreeAccel {
-        if let Some(e) = device.error() {
-            // The scenes are validated before any adapter runs (finite triangles, at least
-            // one), and `available` proved the device works: an error here is Embree's own
-            // failure (out of memory), which no benchmark can go on from.
-            panic!("Embree failed to build the scene: {e:?}");
-        }
-        accel
+/// A built tree, or the error Embree reported while building it.
+fn checked(device: &Device, accel: EmbreeAccel) -> EmbreeAccel {
+    if let Some(e) = device.error() {
+        // The scenes are validated before any adapter runs (finite triangles, at least
+        // one), and `available` proved the device works: an error here is Embree's own
+        // failure (out of memory), which no benchmark can go on from.
+        panic!("Embree failed to build the scene: {e:?}");
     }
+    accel
 }
 
-impl Library for Embree {
-    const NAME: &'static str = "embree";
+/// Embree 3, traced one ray at a time: its default build (`MEDIUM`), or with `HIGH` its
+/// spatial-split build (`RTC_BUILD_QUALITY_HIGH`).
+pub struct Embree<const HIGH: bool = false>;
+
+/// Embree's spatial-split build.
+pub type EmbreeHigh = Embree<true>;
+
+impl<const HIGH: bool> Embree<HIGH> {
+    /// The scene's build quality.
+    const QUALITY: sys::RTCBuildQuality = if HIGH {
+        sys::RTCBuildQuality::HIGH
+    } else {
+        sys::RTCBuildQuality::MEDIUM
+    };
+}
+
+impl<const HIGH: bool> Library for Embree<HIGH> {
+    const NAME: &'static str = if HIGH { "embree-high" } else { "embree" };
     const PARALLEL_BUILD: Option<&'static str> = Some(
         "rtcCommitScene on a device with every thread (TBB), created for the build and released \
          with its tree",
@@ -233,14 +249,14 @@ impl Library for Embree {
     }
 
     fn build(scene: &mut Self::Scene) -> Self::Accel {
-        Self::checked(&scene.device, build_on(&scene.device, scene))
+        checked(&scene.device, build_on(&scene.device, scene, Self::QUALITY))
     }
 
     fn build_mt(scene: &mut Self::Scene) -> Self::Accel {
         // `threads=0`: every hardware thread. The scene retains the device, so it lives (and
         // keeps TBB wide) exactly as long as this tree.
         let device = Device::new("threads=0").expect("Embree device (checked by `available`)");
-        Self::checked(&device, build_on(&device, scene))
+        checked(&device, build_on(&device, scene, Self::QUALITY))
     }
 
     #[inline]

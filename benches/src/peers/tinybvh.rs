@@ -10,7 +10,11 @@
 //!   `tinybvh-bvh4`; under `tinybvh` each measure reports the faster of the two, which the text
 //!   output names. Both are built by the layout's `Build` (tinybvh's default binned SAH builder,
 //!   `BuildAVX` on AVX machines, then leaves regrouped to at most 4 triangles and the tree
-//!   collapsed into the layout): the default, not `BuildHQ` (spatial splits).
+//!   collapsed into the layout): the default, what a renderer gets without asking.
+//! - **Spatial splits**: `tinybvh8-hq` is `BVH8_CPU` built by its `BuildHQ`, tinybvh's SBVH
+//!   builder (binned SAH that may also split triangles, up to half again as many references),
+//!   then the same regrouping and collapse: the like of a spatial-split build of rdbvh.
+//!   Only the 8-wide layout: it is the faster one on every traversal.
 //! - **One thread**: `BVH::threadedBuild` is cleared before a one-thread build; `build_mt` leaves
 //!   it set, and tinybvh's builder then runs its own job system (`hardware_concurrency` threads)
 //!   for meshes of 50,000 triangles and more, and one thread below that.
@@ -31,11 +35,11 @@ extern "C" {
     fn rdbvh_tinybvh_ray_size() -> u32;
     fn rdbvh_tinybvh_ray_align() -> u32;
     fn rdbvh_tinybvh_ray(o: *const f32, d: *const f32, t: f32, out: *mut c_void);
-    fn rdbvh_tinybvh8_build(verts: *const f32, tris: u32, threaded: bool) -> *mut c_void;
+    fn rdbvh_tinybvh8_build(verts: *const f32, tris: u32, threaded: bool, hq: bool) -> *mut c_void;
     fn rdbvh_tinybvh8_free(b: *mut c_void);
     fn rdbvh_tinybvh8_closest(b: *const c_void, ray: *const c_void) -> f32;
     fn rdbvh_tinybvh8_occluded(b: *const c_void, ray: *const c_void) -> bool;
-    fn rdbvh_tinybvh4_build(verts: *const f32, tris: u32, threaded: bool) -> *mut c_void;
+    fn rdbvh_tinybvh4_build(verts: *const f32, tris: u32, threaded: bool, hq: bool) -> *mut c_void;
     fn rdbvh_tinybvh4_free(b: *mut c_void);
     fn rdbvh_tinybvh4_closest(b: *const c_void, ray: *const c_void) -> f32;
     fn rdbvh_tinybvh4_occluded(b: *const c_void, ray: *const c_void) -> bool;
@@ -86,13 +90,16 @@ pub struct TinybvhRay {
 
 /// One of tinybvh's CPU layouts: its build, release and queries through the C ABI.
 pub trait Layout {
-    /// The adapter's name.
+    /// The adapter's name, for the tree of `Build`.
     const NAME: &'static str;
-    /// Builds over `tris` triangles at `verts` (null when out of memory).
+    /// The adapter's name, for the tree of `BuildHQ`.
+    const NAME_HQ: &'static str;
+    /// Builds over `tris` triangles at `verts` with `BuildHQ` if `hq`, else `Build` (null when
+    /// out of memory).
     ///
     /// # Safety
     /// `verts` holds `3 * tris` 16-byte-aligned vertices of 4 floats.
-    unsafe fn build(verts: *const f32, tris: u32, threaded: bool) -> *mut c_void;
+    unsafe fn build(verts: *const f32, tris: u32, threaded: bool, hq: bool) -> *mut c_void;
     /// Releases a tree from [`Layout::build`].
     ///
     /// # Safety
@@ -115,8 +122,9 @@ pub struct Bvh8Cpu;
 
 impl Layout for Bvh8Cpu {
     const NAME: &'static str = "tinybvh-bvh8";
-    unsafe fn build(verts: *const f32, tris: u32, threaded: bool) -> *mut c_void {
-        rdbvh_tinybvh8_build(verts, tris, threaded)
+    const NAME_HQ: &'static str = "tinybvh8-hq";
+    unsafe fn build(verts: *const f32, tris: u32, threaded: bool, hq: bool) -> *mut c_void {
+        rdbvh_tinybvh8_build(verts, tris, threaded, hq)
     }
     unsafe fn free(b: *mut c_void) {
         rdbvh_tinybvh8_free(b)
@@ -136,8 +144,9 @@ pub struct Bvh4Cpu;
 
 impl Layout for Bvh4Cpu {
     const NAME: &'static str = "tinybvh-bvh4";
-    unsafe fn build(verts: *const f32, tris: u32, threaded: bool) -> *mut c_void {
-        rdbvh_tinybvh4_build(verts, tris, threaded)
+    const NAME_HQ: &'static str = "tinybvh4-hq";
+    unsafe fn build(verts: *const f32, tris: u32, threaded: bool, hq: bool) -> *mut c_void {
+        rdbvh_tinybvh4_build(verts, tris, threaded, hq)
     }
     unsafe fn free(b: *mut c_void) {
         rdbvh_tinybvh4_free(b)
@@ -169,21 +178,27 @@ impl<L: Layout> Drop for TinybvhAccel<L> {
     }
 }
 
-/// tinybvh with layout `L`.
-pub struct Tinybvh<L: Layout>(std::marker::PhantomData<L>);
+/// tinybvh with layout `L`, built by `Build`, or with `HQ` by `BuildHQ`.
+pub struct Tinybvh<L: Layout, const HQ: bool = false>(std::marker::PhantomData<L>);
 
 /// The 8-wide adapter.
 pub type TinybvhBvh8 = Tinybvh<Bvh8Cpu>;
 /// The 4-wide adapter.
 pub type TinybvhBvh4 = Tinybvh<Bvh4Cpu>;
+/// The 8-wide adapter with spatial splits.
+pub type TinybvhBvh8Hq = Tinybvh<Bvh8Cpu, true>;
 
-impl<L: Layout> Tinybvh<L> {
+impl<L: Layout, const HQ: bool> Tinybvh<L, HQ> {
     fn build_with(scene: &TinybvhScene, threaded: bool) -> TinybvhAccel<L> {
         // `compare::run` checks the count fits u32 before any adapter is made.
         let tris = (scene.vertices.len() / 3) as u32;
         // SAFETY: the buffer holds 3 * tris aligned 4-float vertices.
-        let tree = unsafe { L::build(scene.vertices.as_ptr().cast(), tris, threaded) };
-        assert!(!tree.is_null(), "{}: out of memory building", L::NAME);
+        let tree = unsafe { L::build(scene.vertices.as_ptr().cast(), tris, threaded, HQ) };
+        assert!(
+            !tree.is_null(),
+            "{}: out of memory building",
+            <Self as Library>::NAME
+        );
         TinybvhAccel {
             tree,
             layout: std::marker::PhantomData,
@@ -191,12 +206,15 @@ impl<L: Layout> Tinybvh<L> {
     }
 }
 
-impl<L: Layout> Library for Tinybvh<L> {
-    const NAME: &'static str = L::NAME;
-    const PARALLEL_BUILD: Option<&'static str> = Some(
+impl<L: Layout, const HQ: bool> Library for Tinybvh<L, HQ> {
+    const NAME: &'static str = if HQ { L::NAME_HQ } else { L::NAME };
+    const PARALLEL_BUILD: Option<&'static str> = Some(if HQ {
+        "the same BuildHQ with BVH::threadedBuild set: tinybvh's job system on every hardware \
+         thread (for 50,000 triangles and more)"
+    } else {
         "the same Build with BVH::threadedBuild set: tinybvh's job system on every hardware \
-         thread (for 50,000 triangles and more)",
-    );
+         thread (for 50,000 triangles and more)"
+    });
     type Scene = TinybvhScene;
     type Ray = TinybvhRay;
     type Accel = TinybvhAccel<L>;

@@ -51,6 +51,7 @@ pub const LIBRARIES: &[&str] = &[
     "obvhs",
     "bvh",
     "parry3d",
+    "rdbvh-wide8-sbvh",
 ];
 /// The library names of the JSON output, in output order: with the C++ peers.
 #[cfg(feature = "cpp-peers")]
@@ -65,6 +66,7 @@ pub const LIBRARIES: &[&str] = &[
     "tinybvh",
     "embree-high",
     "tinybvh8-hq",
+    "rdbvh-wide8-sbvh",
 ];
 
 /// What is measured.
@@ -568,6 +570,7 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
     let mut cwbvh = check::<ObvhsCwbvh>(tris, &sets, &one, &all)?;
     let mut bvh = check::<BvhCrate>(tris, &sets, &one, &all)?;
     let mut parry = check::<Parry>(tris, &sets, &one, &all)?;
+    let mut wide8_sbvh = check::<crate::peers::RdbvhWide8Sbvh>(tris, &sets, &one, &all)?;
     #[cfg(feature = "cpp-peers")]
     let (mut embree, mut tiny8, mut tiny4, mut embree_high, mut tiny8_hq) = {
         crate::peers::embree::available()?;
@@ -593,7 +596,15 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         None
     };
     let mut entries: Vec<&mut dyn Reps> = vec![
-        &mut rdbvh, &mut wide, &mut wide8, &mut bvh2, &mut cwbvh, &mut bvh, &mut parry, &mut top,
+        &mut rdbvh,
+        &mut wide,
+        &mut wide8,
+        &mut bvh2,
+        &mut cwbvh,
+        &mut bvh,
+        &mut parry,
+        &mut top,
+        &mut wide8_sbvh,
     ];
     #[cfg(feature = "cpp-peers")]
     entries.extend([
@@ -603,8 +614,8 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         &mut embree_high as &mut dyn Reps,
         &mut tiny8_hq as &mut dyn Reps,
     ]);
-    // The C++ peers come after the serial top, so the PAH builds are always last.
-    let cpp_entries = entries.len() - 8;
+    // The C++ peers come after the serial top and the SBVH, so the PAH builds are always last.
+    let cpp_entries = entries.len() - 9;
     if let Some(p) = pah_reps.as_mut() {
         entries.push(p);
     }
@@ -621,14 +632,16 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
     ];
     #[cfg(feature = "cpp-peers")]
     runs.extend([
-        embree.run(&t[8]),
-        tiny8.run(&t[9]),
-        tiny4.run(&t[10]),
-        embree_high.run(&t[11]),
-        tiny8_hq.run(&t[12]),
+        embree.run(&t[9]),
+        tiny8.run(&t[10]),
+        tiny4.run(&t[11]),
+        embree_high.run(&t[12]),
+        tiny8_hq.run(&t[13]),
     ]);
+    // Last, so the lines of the libraries before it keep their order.
+    runs.push(wide8_sbvh.run(&t[8]));
     let serial_top = (t[7][0], t[7][1]);
-    let pah = t.get(8 + cpp_entries).map(|p| PahBuilds {
+    let pah = t.get(9 + cpp_entries).map(|p| PahBuilds {
         sah: p[0],
         full_plane: p[1],
         full_point: p[2],

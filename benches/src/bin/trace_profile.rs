@@ -1,11 +1,12 @@
 //! `trace_profile SCENE [REPS]`: the four traversal measures of the `peers` table for
-//! `rdbvh-wide` and its 8-wide tree `rdbvh-wide8` alone (with `--features cpp-peers`, Embree's
-//! and tinybvh's BVH8 beside them, each by its default build and by its spatial-split build,
-//! `embree-high` and `tinybvh8-hq`), in interleaved rounds, best thread CPU time of `REPS`
-//! (default 7): a quick before/after check of the traversal kernel that builds in `release` and
-//! skips the builds and the Rust peers. SCENE is a name under `../shared/scenes` or a path to an
-//! OBJ file. rdbvh's ratios are over the faster of the C++ default builds, which like rdbvh's
-//! SAH build split no triangles.
+//! `rdbvh-wide`, its 8-wide tree `rdbvh-wide8` and the 8-wide SBVH `rdbvh-wide8-sbvh` alone (with
+//! `--features cpp-peers`, Embree's and tinybvh's BVH8 beside them, each by its default build and
+//! by its spatial-split build, `embree-high` and `tinybvh8-hq`), in interleaved rounds, best
+//! thread CPU time of `REPS` (default 7): a quick before/after check of the traversal kernel that
+//! builds in `release` and skips the builds and the Rust peers. SCENE is a name under
+//! `../shared/scenes` or a path to an OBJ file. Like against like: `wide` and `wide8` (no split
+//! triangles) are over the faster of the C++ default builds, `sbvh` over the faster of their
+//! spatial-split builds.
 //!
 //! `RDBVH_PROFILE_ONLY=closest_camera` (or `closest_random`, `any_random`, `any_shadow`) runs that
 //! measure alone, once per round, inside `trace_profile::trace_once`, for
@@ -15,7 +16,7 @@ use std::fmt::Write as _;
 use std::hint::black_box;
 use std::process::ExitCode;
 
-use rdbvh_benches::peers::{Library, Prepared, RdbvhWide, RdbvhWide8};
+use rdbvh_benches::peers::{Library, Prepared, RdbvhWide, RdbvhWide8, RdbvhWide8Sbvh};
 use rdbvh_benches::{bounds, open_scene, ray_set, thread_cpu_seconds, RayKind};
 use rdbvh_core::geometry::{Ray, Triangle};
 
@@ -80,8 +81,12 @@ fn cpp_peers(_: &[Triangle], _: &[Vec<Ray>]) -> Vec<(&'static str, Box<dyn Timed
     Vec::new()
 }
 
-/// How many of [`cpp_peers`] are default builds, the base of rdbvh's ratios.
+/// How many of [`cpp_peers`] are default builds (the base of the unsplit trees' ratios); the
+/// rest are spatial-split builds (the SBVH's base).
 const DEFAULT_BUILDS: usize = 2;
+
+/// rdbvh's trees in the table: 4-wide, 8-wide, 8-wide SBVH.
+const RDBVH: usize = 3;
 
 /// One pass over a ray set: the timed (and, under callgrind, the counted) work.
 #[inline(never)]
@@ -118,9 +123,10 @@ fn main() -> ExitCode {
         .collect();
     let wide = Traced::<RdbvhWide>::new(&tris, &sets);
     let wide8 = Traced::<RdbvhWide8>::new(&tris, &sets);
+    let sbvh = Traced::<RdbvhWide8Sbvh>::new(&tris, &sets);
     let peers = cpp_peers(&tris, &sets);
-    // Per measure: rdbvh-wide, rdbvh-wide8, then each C++ peer.
-    let mut best = vec![vec![f64::INFINITY; 2 + peers.len()]; MEASURES.len()];
+    // Per measure: rdbvh-wide, rdbvh-wide8, rdbvh-wide8-sbvh, then each C++ peer.
+    let mut best = vec![vec![f64::INFINITY; RDBVH + peers.len()]; MEASURES.len()];
     let mut peer_hits = vec![0; peers.len()];
     for _ in 0..reps {
         for &m in &chosen {
@@ -128,13 +134,18 @@ fn main() -> ExitCode {
             best[m][0] = best[m][0].min(t);
             let (t8, hits8) = wide8.time(m);
             best[m][1] = best[m][1].min(t8);
-            if hits8 != hits {
-                eprintln!("{}: hits {hits} 4-wide, {hits8} 8-wide", MEASURES[m].0);
+            let (ts, hits_s) = sbvh.time(m);
+            best[m][2] = best[m][2].min(ts);
+            if hits8 != hits || hits_s != hits {
+                eprintln!(
+                    "{}: hits {hits} 4-wide, {hits8} 8-wide, {hits_s} SBVH",
+                    MEASURES[m].0
+                );
                 return ExitCode::FAILURE;
             }
             for (i, (_, peer)) in peers.iter().enumerate() {
                 let (tp, hp) = peer.time(m);
-                best[m][2 + i] = best[m][2 + i].min(tp);
+                best[m][RDBVH + i] = best[m][RDBVH + i].min(tp);
                 peer_hits[i] = hp;
             }
             // Shared-edge rays may differ by a few; a large gap means a broken kernel.
@@ -153,23 +164,23 @@ fn main() -> ExitCode {
     for &m in &chosen {
         let n = sets[m].len() as f64;
         let rate = |t: f64| n / t * 1e-6;
-        let (w, w8) = (rate(best[m][0]), rate(best[m][1]));
+        let (w, w8, ws) = (rate(best[m][0]), rate(best[m][1]), rate(best[m][2]));
         let mut line = format!("{:<15} wide {w:>6.2}", MEASURES[m].0);
         if peers.is_empty() {
-            let _ = write!(line, "  wide8 {w8:>6.2}");
+            let _ = write!(line, "  wide8 {w8:>6.2}  sbvh {ws:>6.2}");
         } else {
-            let base = best[m][2..2 + DEFAULT_BUILDS]
-                .iter()
-                .map(|&t| rate(t))
-                .fold(0.0, f64::max);
+            let fastest = |builds: &[f64]| builds.iter().map(|&t| rate(t)).fold(0.0, f64::max);
+            let base = fastest(&best[m][RDBVH..RDBVH + DEFAULT_BUILDS]);
+            let split_base = fastest(&best[m][RDBVH + DEFAULT_BUILDS..]);
             let _ = write!(
                 line,
-                " ({:.2}x)  wide8 {w8:>6.2} ({:.2}x)",
+                " ({:.2}x)  wide8 {w8:>6.2} ({:.2}x)  sbvh {ws:>6.2} ({:.2}x)",
                 w / base,
-                w8 / base
+                w8 / base,
+                ws / split_base
             );
             for (i, (name, _)) in peers.iter().enumerate() {
-                let _ = write!(line, "  {name} {:>6.2}", rate(best[m][2 + i]));
+                let _ = write!(line, "  {name} {:>6.2}", rate(best[m][RDBVH + i]));
             }
         }
         println!("{line}");

@@ -1,12 +1,15 @@
 //! Build with every preset and both builders over arbitrary triangles, and reinsert each tree,
 //! then check the tree invariants and every traversal (binary and 4-wide) against brute force;
-//! both builders' trees built `for_wide` must collapse to the same 4-wide nodes.
+//! both builders' trees built `for_wide` must collapse to the same 4-wide nodes. An SBVH with
+//! arbitrary settings is checked the same way, as far as split triangles allow.
 #![no_main]
 
 use arbitrary::{Result, Unstructured};
 use libfuzzer_sys::fuzz_target;
+use rdbvh_core::brute_force;
 use rdbvh_core::builder::{
-    reinsert, BuildArena, BuildOptions, Builder, Preset, ReinsertConfig,
+    reinsert, BuildArena, BuildOptions, Builder, Preset, ReinsertConfig, SpatialBuilder,
+    SpatialSplits,
 };
 use rdbvh_core::bvh::{Bvh, WideBvh, MAX_DEPTH};
 use rdbvh_core::geometry::{Ray, Triangle};
@@ -75,7 +78,8 @@ fn run(u: &mut Unstructured) -> Result<()> {
         for preset in Preset::ALL {
             let mut bvh = Bvh::with_capacity(tris.len());
             let area: Option<&InfluenceArea> = Some(&area);
-            let stats = BuildOptions::with_settings(preset, options).build_into(&mut arena, area, &mut bvh);
+            let stats =
+                BuildOptions::with_settings(preset, options).build_into(&mut arena, area, &mut bvh);
             if let Err(e) = stats {
                 panic!(
                     "preset {preset} {options:?} over {} triangles: {e}",
@@ -119,6 +123,38 @@ fn run(u: &mut Unstructured) -> Result<()> {
             check_queries(bvh, &wide, &tris, ray, what);
         }
     }
+    // The SBVH: split triangles may sit in several leaves, so `validate_split`, and closest and
+    // any hit (an all-hit count would count a split triangle once per part) against brute force.
+    let splits = SpatialSplits {
+        alpha: if u.arbitrary::<bool>()? { 0.0 } else { 1e-5 },
+        budget: f32::from(u.int_in_range(0u8..=8)?) * 0.25,
+        spatial_bins: u.int_in_range(2u32..=64)?,
+        max_leaf: u.int_in_range(1u32..=8)?,
+        ..SpatialSplits::default()
+    };
+    match (SpatialBuilder::new(splits).build(&tris), expect_err) {
+        (Ok(bvh), None) => {
+            let what = format!("sbvh {splits:?}");
+            if let Err(e) = bvh.validate_split(tris.len(), |i| tris[i as usize].bounds()) {
+                panic!("{what}: invalid SBVH over {} triangles: {e}", tris.len());
+            }
+            let wide = WideBvh::from_binary(&bvh, &tris);
+            for ray in rays.iter().filter(|r| known_core_bug(r, &tris).is_none()) {
+                let expect = brute_force::closest_hit(ray, &tris);
+                assert_eq!(bvh.closest_hit(ray, &tris), expect, "{what}: {ray:?}");
+                assert_eq!(wide.closest_hit(ray), expect, "{what} 4-wide: {ray:?}");
+                let any = expect.is_some();
+                assert_eq!(bvh.any_hit(ray, &tris), any, "{what}: {ray:?}");
+                assert_eq!(wide.any_hit(ray), any, "{what} 4-wide: {ray:?}");
+            }
+        }
+        (Err(e), Some(x)) => assert_eq!(e, x, "sbvh"),
+        (r, x) => panic!(
+            "sbvh {splits:?}: got {:?}, expected error {x:?}",
+            r.map(|_| ())
+        ),
+    }
+
     // An empty scene hits nothing, whatever the ray.
     if tris.is_empty() {
         let empty: &[Triangle] = &[];

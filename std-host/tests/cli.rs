@@ -110,6 +110,48 @@ fn build_table_and_builders() {
     assert!(text(&lsph.stdout).contains("lsph (8 bins"));
 }
 
+/// `--builder sbvh` builds with spatial splits (the room's long wall and floor quads split, so
+/// the tree holds more references than triangles), and `--perspective-estimate` builds a point
+/// area's PAH tree whose exact PAH cost stays near the exact build's (the room's bulb sits among
+/// boxes close to it, where the centre estimate errs most: 1.06x).
+#[test]
+fn build_sbvh_and_the_perspective_estimate() {
+    let sah = json_of(&rdbvh(&["build", "builtin:room", "--json"]));
+    let sbvh = json_of(&rdbvh(&[
+        "build",
+        "builtin:room",
+        "--builder",
+        "sbvh",
+        "--json",
+    ]));
+    assert_eq!(sbvh["builder"], "sbvh");
+    let cost = |j: &serde_json::Value| j["sah_cost"].as_f64().unwrap();
+    assert!(cost(&sbvh) < cost(&sah), "SBVH {sbvh} against SAH {sah}");
+    let references = (sbvh["bytes"].as_u64().unwrap() - sbvh["nodes"].as_u64().unwrap() * 32) / 4;
+    assert!(references > sbvh["triangles"].as_u64().unwrap(), "{sbvh}");
+
+    let dir = scratch("perspective-estimate");
+    let areas = dir.join("point.toml");
+    let point = ROOM_AREAS.split("[[area]]").nth(2).unwrap();
+    std::fs::write(&areas, format!("[[area]]{point}")).unwrap();
+    let areas = areas.to_str().unwrap();
+    let args = [
+        "build",
+        "builtin:room",
+        "--preset",
+        "pah",
+        "--areas",
+        areas,
+        "--json",
+    ];
+    let exact = json_of(&rdbvh(&args));
+    let estimate = json_of(&rdbvh(&[&args[..], &["--perspective-estimate"]].concat()));
+    assert_eq!(exact["area_kind"], "point");
+    let pah = |j: &serde_json::Value| j["pah_cost"].as_f64().unwrap();
+    let ratio = pah(&estimate) / pah(&exact);
+    assert!((0.9..1.15).contains(&ratio), "{estimate} against {exact}");
+}
+
 #[test]
 fn demo_runs_and_checks_itself() {
     let out = rdbvh(&[]);

@@ -8,7 +8,9 @@
 //!
 //! `RDBVH_PROFILE_PAH=1` adds the `full` (PAH + SPFH) and `pah` (PAH over all axes) presets over
 //! the `peers` table's plane and point areas: CPU time, its ratio to the SAH build's, and the
-//! tree's PAH cost (`C_trav = C_isect = 1`) and hash; `plane` or `point` instead of `1` builds over that area alone, and
+//! tree's PAH cost (`C_trav = C_isect = 1`) and hash, and over the point area each preset again
+//! pricing its splits by the centre estimate (`PresetOptions::perspective_estimate`), its tree's
+//! PAH cost still by the exact measure; `plane` or `point` instead of `1` builds over that area alone, and
 //! `RDBVH_PROFILE_PRESET=full` (or `pah`) that preset alone (for
 //! `--toggle-collect=build_profile::pah_once`).
 //! With AREAS.toml (an area file, as `rdbvh build --areas` takes), PRESET (default `full`) is
@@ -45,17 +47,23 @@ fn build_mt_once(tris: &[Triangle]) -> Bvh {
     rdbvh_core::builder::parallel::build(&Builder::sah(), black_box(tris)).expect("finite scene")
 }
 
-/// One timed build of `preset` over `area`: loading the bounds and the preset's build.
+/// One timed build of `preset` over `area`: loading the bounds and the preset's build, pricing a
+/// point area's splits by the centre estimate when `estimate`.
 #[inline(never)]
 fn pah_once(
     tris: &[Triangle],
     preset: Preset,
     area: &InfluenceArea,
+    estimate: bool,
     arena: &mut BuildArena,
     out: &mut Bvh,
 ) -> Result<(), PresetError> {
     arena.load_triangles(black_box(tris)).expect("finite");
-    BuildOptions::with_settings(preset, PresetOptions::default())
+    let settings = PresetOptions {
+        perspective_estimate: estimate,
+        ..PresetOptions::default()
+    };
+    BuildOptions::with_settings(preset, settings)
         .build_into(arena, Some(area), out)
         .map(|_| ())
 }
@@ -167,15 +175,28 @@ fn main() -> ExitCode {
             ("point", point_area_over(&b).expect("point").into()),
         ];
         let areas = areas.iter().filter(|(name, _)| pah == "1" || pah == *name);
-        for ((name, area), preset) in areas.flat_map(|a| presets.clone().map(move |p| (a, p))) {
+        let runs = areas
+            .flat_map(|a| presets.clone().map(move |p| (a, p)))
+            .flat_map(|((name, area), p)| {
+                let point = matches!(area, InfluenceArea::Point(_));
+                [(name, area, p, false), (name, area, p, true)]
+                    .into_iter()
+                    .filter(move |r| point || !r.3)
+            });
+        for (name, area, preset, estimate) in runs {
             let mut arena = BuildArena::with_capacity(n);
             let mut out = Bvh::with_capacity(n);
             let mut best_pah = f64::INFINITY;
             for _ in 0..reps {
                 let t = thread_cpu_seconds();
-                pah_once(&tris, preset, area, &mut arena, &mut out).expect("pah build");
+                pah_once(&tris, preset, area, estimate, &mut arena, &mut out).expect("pah build");
                 best_pah = best_pah.min(thread_cpu_seconds() - t);
             }
+            let name = if estimate {
+                format!("{name} (centre estimate)")
+            } else {
+                name.to_string()
+            };
             let pah = AreaPah::new(area, PresetOptions::default().perspective);
             let pah_cost =
                 out.estimated_cost_over(&pah, CostConstants::default(), pah.window_measure());
@@ -195,7 +216,7 @@ fn main() -> ExitCode {
             let mut best_area = f64::INFINITY;
             for _ in 0..reps {
                 let t = thread_cpu_seconds();
-                if let Err(e) = pah_once(&tris, *preset, &entry.area, &mut arena, &mut out) {
+                if let Err(e) = pah_once(&tris, *preset, &entry.area, false, &mut arena, &mut out) {
                     eprintln!("error: area {} (line {}): {e}", entry.index, entry.line);
                     return ExitCode::FAILURE;
                 }

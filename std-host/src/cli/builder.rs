@@ -113,6 +113,12 @@ pub struct BuilderArgs {
     /// cost falls 17% and its rays trace about 1.2x faster, for about half the build's time more.
     #[arg(long)]
     pub reinsert: bool,
+    /// With a point area (PAH presets): price splits by the perspective PAH's centre estimate,
+    /// each box's faces counted as if at its centre, instead of the exact solid angle: about 1.4x
+    /// the SAH build's time instead of 2x, for a PAH cost within a few percent of the exact
+    /// build's (reported costs stay exact).
+    #[arg(long)]
+    pub perspective_estimate: bool,
 }
 
 /// A BVH with what its build reported and how long it took.
@@ -183,6 +189,7 @@ impl BuilderArgs {
         if let Some(max_leaf) = self.max_leaf {
             o.max_leaf = max_leaf;
         }
+        o.perspective_estimate = self.perspective_estimate;
         o
     }
 

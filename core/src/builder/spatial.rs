@@ -51,8 +51,8 @@ pub struct SpatialSplits {
 }
 
 impl Default for SpatialSplits {
-    /// Stich et al.'s `alpha = 1e-5`, up to half as many references again, 16 object bins and
-    /// 32 spatial bins (as Embree and tinybvh bin), leaves of at most 8 (the `sah` preset's).
+    /// Stich et al.'s `alpha = 1e-5`, up to half as many references again, 16 object bins (the
+    /// `sah` preset's) and 32 spatial bins, leaves of at most 8 (the `sah` preset's).
     fn default() -> Self {
         Self {
             alpha: 1e-5,
@@ -138,8 +138,8 @@ pub struct SpatialBuilder {
     pub splits: SpatialSplits,
 }
 
-/// A box as two SIMD lanes: the build's loops grow, clip and measure boxes in every step, and
-/// [`Aabb`]'s scalar `Vec3` corners took three times the instructions.
+/// A box as two SIMD lanes (glam's `Vec3A`): the build's loops grow, clip and intersect boxes in
+/// every step, each then one `minps` or `maxps` per corner.
 #[derive(Clone, Copy, Debug)]
 struct Box3 {
     min: Vec3A,
@@ -242,8 +242,8 @@ struct Task {
     depth: u32,
 }
 
-/// A bin of either sweep: the box of what fell in it, and for spatial bins how many fragments
-/// start (`enter`) and end (`exit`) in it; object bins count in `enter`.
+/// A bin of either sweep: the box of what fell in it, and how many fragments start (`enter`) and
+/// end (`exit`) in it (an object bin's fragments do both).
 #[derive(Clone, Copy, Debug)]
 struct SweepBin {
     bounds: Box3,
@@ -629,7 +629,7 @@ impl Run<'_> {
     }
 
     /// Moves the fragments of `task` into the children's slot ranges and returns the children's
-    /// tasks (node and depth still to set). Fills in the children's boxes of a median split.
+    /// tasks (node and depth still to set).
     fn apply(&mut self, task: &Task, priced: &Priced) -> (Task, Task) {
         let (start, n) = (task.start as usize, task.count as usize);
         let (n_left, n_right, moved) = match priced.split {

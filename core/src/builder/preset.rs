@@ -107,9 +107,9 @@ pub struct PresetOptions {
     /// How perspective PAH measures a projection (point areas).
     pub perspective: PerspectiveMeasure,
     /// Price a point area's splits by the perspective PAH's centre estimate
-    /// ([`PahPerspective::estimated`]), an opt-in stand-in that builds about as fast as SAH, for
-    /// a slightly higher PAH cost; off by default. Reinsertion and cost reports keep the exact
-    /// measure.
+    /// ([`PahPerspective::estimated`]), an opt-in stand-in: about 1.4-1.6x an SAH build's time
+    /// instead of 2x, for a PAH cost within about 1% of the exact build's on the bunny and Sponza;
+    /// off by default. Reinsertion and cost reports keep the exact measure.
     pub perspective_estimate: bool,
     /// Reproduce the thesis's builder: candidate planes uniformly over the node box, leaves split
     /// down to `max_leaf` by size alone (no cost-based termination).

@@ -46,6 +46,8 @@ pub struct PahPerspective {
     cull: bool,
     /// Price boxes by [`PahPerspective::estimated`]'s centre estimate instead of exactly.
     estimate: bool,
+    /// [`PahPerspective::window_measure`], which the estimate clamps every box to.
+    window: f32,
     lanes: Lanes,
 }
 
@@ -104,6 +106,7 @@ impl PahPerspective {
             measure,
             cull: true,
             estimate: false,
+            window: window_measure(measure, f.tan_x, f.tan_y),
             lanes: Lanes::new(f.eye, &f.frame, (f.tan_x, f.tan_y), (near, f.far), true),
         }
     }
@@ -116,10 +119,10 @@ impl PahPerspective {
     /// the depth (image plane), clamped to the window's measure, and zero when it lies wholly
     /// outside the culled pyramid. One root and one division per box and no branch on the box's
     /// position, where the exact measure clips a hull near the eye and takes a root and a
-    /// division per face elsewhere. Inside a node all
-    /// children sit at about the node's distance, so the split choice, which compares children
-    /// within a node, loses little (measured: benches/RESULTS.md, section Perspective PAH build
-    /// cost). Estimate a built tree's cost with the exact model, not this one.
+    /// division per face elsewhere. Inside a node all children sit at about the node's distance,
+    /// so the split choice, which compares children within a node, loses little (measured:
+    /// benches/RESULTS.md, section Perspective PAH build cost). Estimate a built tree's cost with
+    /// the exact model, not this one.
     pub fn estimated(self) -> Self {
         Self {
             estimate: true,
@@ -140,17 +143,17 @@ impl PahPerspective {
         // The distance (solid angle) or the depth (image plane).
         let r = self.reach(&c);
         let inv_r2 = f32x4::ONE / (r * r);
-        let (four, one_half) = (f32x4::splat(4.0), f32x4::splat(1.5));
+        let (four, three_halves) = (f32x4::splat(4.0), f32x4::splat(1.5));
         let mut sum = f32x4::ZERO;
         for k in 0..3 {
             let (a1, a2) = ((k + 1) % 3, (k + 2) % 3);
             let ck = c[k].abs();
             let along = (ck - h[k]).fast_max(f32x4::ZERO);
             let x = (h[k] * h[k] - f32x4::splat(2.0) * ck * h[k]) * inv_r2;
-            sum += four * h[a1] * h[a2] * along * (f32x4::ONE - one_half * x);
+            sum += four * h[a1] * h[a2] * along * (f32x4::ONE - three_halves * x);
         }
         let m = sum * inv_r2 / r;
-        let window = f32x4::splat(self.window_measure());
+        let window = f32x4::splat(self.window);
         // The eye inside or behind a box (depth <= 0, a division by zero, NaN) sees at most
         // the window.
         let m = (m.simd_ge(f32x4::ZERO) & m.simd_le(window)).select(m, window);
@@ -192,13 +195,7 @@ impl PahPerspective {
     /// The measure of the whole window: the frustum's solid angle
     /// `4 atan(tx ty / sqrt(1 + tx^2 + ty^2))`, or its image-plane area `4 tx ty`.
     pub fn window_measure(&self) -> f32 {
-        let (tx, ty) = (self.tan_x, self.tan_y);
-        match self.measure {
-            PerspectiveMeasure::SolidAngle => {
-                4.0 * libm::atanf(tx * ty / libm::sqrtf(1.0 + tx * tx + ty * ty))
-            }
-            PerspectiveMeasure::ImagePlane => 4.0 * tx * ty,
-        }
+        self.window
     }
 
     /// The projected silhouette of `b` beyond the near plane, on the image plane `z = 1`.
@@ -491,6 +488,17 @@ impl CostModel for PahPerspective {
             }
         }
         f32x4::from(out)
+    }
+}
+
+/// The measure of a window of half-angle tangents `tx` and `ty` (see
+/// [`PahPerspective::window_measure`]).
+fn window_measure(measure: PerspectiveMeasure, tx: f32, ty: f32) -> f32 {
+    match measure {
+        PerspectiveMeasure::SolidAngle => {
+            4.0 * libm::atanf(tx * ty / libm::sqrtf(1.0 + tx * tx + ty * ty))
+        }
+        PerspectiveMeasure::ImagePlane => 4.0 * tx * ty,
     }
 }
 

@@ -107,7 +107,7 @@ pub struct PresetOptions {
     /// How perspective PAH measures a projection (point areas).
     pub perspective: PerspectiveMeasure,
     /// Price a point area's splits by the perspective PAH's centre estimate
-    /// ([`PahPerspective::estimated`]), an opt-in stand-in: about 1.4-1.6x an SAH build's time
+    /// ([`PahPerspective::estimated`]), an opt-in stand-in: about 1.3-1.5x an SAH build's time
     /// instead of 2x, for a PAH cost within about 1% of the exact build's on the bunny and Sponza;
     /// off by default. Reinsertion and cost reports keep the exact measure.
     pub perspective_estimate: bool,

@@ -113,10 +113,10 @@ pub struct BuilderArgs {
     /// cost falls 17% and its rays trace about 1.2x faster, for about half the build's time more.
     #[arg(long)]
     pub reinsert: bool,
-    /// With a point area (PAH presets): price splits by the perspective PAH's centre estimate,
-    /// each box's faces counted as if at its centre, instead of the exact solid angle: about 1.4x
-    /// the SAH build's time instead of 2x, for a PAH cost within a few percent of the exact
-    /// build's (reported costs stay exact).
+    /// With a point area (PAH presets): price splits by the perspective PAH's centre estimate
+    /// (each face turned towards the light at its own distance, expanded about the box's
+    /// centre) instead of the exact solid angle: about 1.3-1.5x the SAH build's time instead of
+    /// 2x, for a PAH cost within a few percent of the exact build's (reported costs stay exact).
     #[arg(long)]
     pub perspective_estimate: bool,
 }

@@ -379,6 +379,11 @@ impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
                 return Some(hit);
             }
             searched_to = searched_to.max(t_exit - t_exit.abs() * EXIT_OVERLAP);
+            // The segment ends inside the area, past the overlap: the local BVH searched all of
+            // it, and the fallback would search an empty segment.
+            if searched_to >= ray.t_max {
+                return None;
+            }
         }
         let rest = Ray {
             t_min: searched_to,
@@ -401,6 +406,9 @@ impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
                 return true;
             }
             searched_to = searched_to.max(t_exit - t_exit.abs() * EXIT_OVERLAP);
+            if searched_to >= ray.t_max {
+                return false;
+            }
         }
         let rest = Ray {
             t_min: searched_to,

@@ -1,6 +1,7 @@
 //! Closest-hit and any-hit traversal of camera rays and random rays, and any hit of shadow
 //! segments, on the bunny and Crytek Sponza: rdbvh beside the peers (with the C++ ones under the
-//! `cpp-peers` feature), on the same triangles and the same rays, throughput in rays.
+//! `cpp-peers` feature, each by its default build and its spatial-split build, beside rdbvh's
+//! SBVH), on the same triangles and the same rays, throughput in rays.
 //!
 //! Before anything is timed, every library's answers are compared with rdbvh's, ray by ray, and
 //! the run stops if any library agrees on fewer than [`MIN_AGREEMENT`] of the rays: a speed
@@ -17,6 +18,7 @@ use criterion::{
 };
 use rdbvh_benches::peers::{
     BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Prepared, Rdbvh, RdbvhWide, RdbvhWide8,
+    RdbvhWide8Sbvh,
 };
 use rdbvh_benches::{
     agreement, bounds, load_scene, ray_set, Answers, RayKind, BENCH_SCENES, MIN_AGREEMENT,
@@ -92,6 +94,7 @@ fn traversals(c: &mut Criterion<Clock>) {
         let rdbvh = Subject::<Rdbvh>::new(name, &tris, &sets);
         let wide = Subject::<RdbvhWide>::new(name, &tris, &sets);
         let wide8 = Subject::<RdbvhWide8>::new(name, &tris, &sets);
+        let sbvh = Subject::<RdbvhWide8Sbvh>::new(name, &tris, &sets);
         let obvhs2 = Subject::<ObvhsBvh2>::new(name, &tris, &sets);
         let obvhs8 = Subject::<ObvhsCwbvh>::new(name, &tris, &sets);
         let bvh = Subject::<BvhCrate>::new(name, &tris, &sets);
@@ -113,6 +116,11 @@ fn traversals(c: &mut Criterion<Clock>) {
                 Subject::<rdbvh_benches::peers::TinybvhBvh4>::new(name, &tris, &sets),
             )
         };
+        #[cfg(feature = "cpp-peers")]
+        let (embree_high, tiny8_hq) = (
+            Subject::<rdbvh_benches::peers::EmbreeHigh>::new(name, &tris, &sets),
+            Subject::<rdbvh_benches::peers::TinybvhBvh8Hq>::new(name, &tris, &sets),
+        );
         for (query, any) in [("closest", false), ("any", true)] {
             for (kind, rays, _) in &sets {
                 // Shadow segments are any-hit queries only, as renderers trace them.
@@ -130,6 +138,7 @@ fn traversals(c: &mut Criterion<Clock>) {
                 rdbvh.bench(&mut group, *kind, any);
                 wide.bench(&mut group, *kind, any);
                 wide8.bench(&mut group, *kind, any);
+                sbvh.bench(&mut group, *kind, any);
                 obvhs2.bench(&mut group, *kind, any);
                 obvhs8.bench(&mut group, *kind, any);
                 bvh.bench(&mut group, *kind, any);
@@ -139,6 +148,8 @@ fn traversals(c: &mut Criterion<Clock>) {
                     embree.bench(&mut group, *kind, any);
                     tiny8.bench(&mut group, *kind, any);
                     tiny4.bench(&mut group, *kind, any);
+                    embree_high.bench(&mut group, *kind, any);
+                    tiny8_hq.bench(&mut group, *kind, any);
                 }
                 group.finish();
             }

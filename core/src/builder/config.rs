@@ -123,14 +123,6 @@ impl BuildConfig {
                 ));
             }
         }
-        let k = self.constants;
-        let traversal_ok = k.traversal.is_finite() && k.traversal >= 0.0;
-        let intersection_ok = k.intersection.is_finite() && k.intersection > 0.0;
-        if !(traversal_ok && intersection_ok) {
-            return Err(BuildError::InvalidConfig(
-                "cost constants must be finite, C_trav >= 0 and C_isect > 0",
-            ));
-        }
-        Ok(())
+        self.constants.validate()
     }
 }

@@ -86,15 +86,7 @@ impl SpatialSplits {
         if self.max_leaf == 0 {
             return Err(BuildError::InvalidConfig("max_leaf must be at least 1"));
         }
-        let k = self.constants;
-        let traversal_ok = k.traversal.is_finite() && k.traversal >= 0.0;
-        let intersection_ok = k.intersection.is_finite() && k.intersection > 0.0;
-        if !(traversal_ok && intersection_ok) {
-            return Err(BuildError::InvalidConfig(
-                "cost constants must be finite, C_trav >= 0 and C_isect > 0",
-            ));
-        }
-        Ok(())
+        self.constants.validate()
     }
 }
 

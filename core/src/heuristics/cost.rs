@@ -32,6 +32,20 @@ impl CostConstants {
         traversal: 2.0,
         intersection: 1.2,
     };
+
+    /// Checks that both are finite, `C_trav >= 0` and `C_isect > 0` (what every builder needs
+    /// to price a split against a leaf).
+    pub(crate) fn validate(&self) -> Result<(), crate::BuildError> {
+        let traversal_ok = self.traversal.is_finite() && self.traversal >= 0.0;
+        let intersection_ok = self.intersection.is_finite() && self.intersection > 0.0;
+        if traversal_ok && intersection_ok {
+            Ok(())
+        } else {
+            Err(crate::BuildError::InvalidConfig(
+                "cost constants must be finite, C_trav >= 0 and C_isect > 0",
+            ))
+        }
+    }
 }
 
 /// A hit measure: `measure(child) / measure(parent)` is the probability that a ray of the modelled

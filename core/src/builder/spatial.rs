@@ -6,8 +6,9 @@
 //! (Sponza's walls and arches) gets children whose boxes overlap, and every ray through the
 //! overlap visits both. A spatial split trades that overlap for duplicate references. Each node
 //! prices its best object split (centroid bins, every axis) and, where that split's children
-//! overlap by more than `alpha` of the root's area, its best spatial split (bins over the node's
-//! box, each triangle clipped into the bins it crosses), then keeps the cheaper one, with
+//! overlap by more than `alpha` of the root's area and that holds more than twice `max_leaf`
+//! fragments, its best spatial split (bins over the node's box, each triangle's part in each bin
+//! it crosses), then keeps the cheaper one, with
 //! reference unsplitting: a straddling triangle goes to one side whole when that prices lower.
 //!
 //! References live in one buffer of `(1 + budget) n` slots. A node owns a slot range larger than
@@ -34,8 +35,9 @@ use crate::BuildError;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpatialSplits {
     /// Spatial splits are priced only in nodes whose best object split's children overlap by
-    /// more than `alpha` times the root's surface area (Stich et al.: `1e-5`). 0 prices them in
-    /// every node; 1 or more, in none.
+    /// more than `alpha` times the root's surface area (Stich et al.: `1e-5`), and that hold
+    /// more than twice `max_leaf` fragments. 0 prices them in every such node; 1 or more, in
+    /// none.
     pub alpha: f32,
     /// Duplicate references allowed, as a fraction of the triangle count: `0.5` lets the tree
     /// hold up to `1.5 n` references. 0 gives a plain binned SAH tree.
@@ -94,7 +96,8 @@ impl SpatialSplits {
 /// plane through their triangles, a straddling triangle going to both children with its box
 /// clipped to each side (or whole to one side where that prices lower). Spatial splits are
 /// priced where the best object split's children overlap by more than
-/// [`SpatialSplits::alpha`] of the root's area, within a budget of duplicate references
+/// [`SpatialSplits::alpha`] of the root's area (in nodes of more than twice
+/// [`SpatialSplits::max_leaf`] fragments), within a budget of duplicate references
 /// ([`SpatialSplits::budget`]) handed down the tree as spare slots, so the build allocates
 /// nothing once started. The result is a [`Bvh`] whose leaves may name a triangle more than once
 /// across the tree (never twice in one leaf; [`Bvh::validate_split`]); every traversal finds the

@@ -150,6 +150,14 @@ fn build_sbvh_and_the_perspective_estimate() {
     let pah = |j: &serde_json::Value| j["pah_cost"].as_f64().unwrap();
     let ratio = pah(&estimate) / pah(&exact);
     assert!((0.9..1.15).contains(&ratio), "{estimate} against {exact}");
+    // Without a preset the flag would change nothing: a usage error, before loading anything.
+    let args = ["build", "builtin:room", "--perspective-estimate"];
+    assert_one_line_error(
+        &rdbvh(&args),
+        2,
+        &["--perspective-estimate", "--preset"],
+        &args,
+    );
 }
 
 #[test]

@@ -210,11 +210,19 @@ impl BuilderArgs {
     }
 
     /// A usage error when the preset needs an influence area and `has_area` is false, or when
-    /// --thesis-mode has no preset to apply to, so the command can say so before loading anything.
+    /// --thesis-mode or --perspective-estimate has no preset to apply to, so the command can say
+    /// so before loading anything.
     pub fn check_area(&self, has_area: bool) -> Result<(), CliError> {
         if self.thesis_mode && self.preset().is_none() {
             return Err(CliError::Usage(
                 "--thesis-mode applies to presets: give --preset NAME".into(),
+            ));
+        }
+        if self.perspective_estimate && self.preset().is_none() {
+            return Err(CliError::Usage(
+                "--perspective-estimate applies to the PAH presets over a point area: give \
+                 --preset NAME and --areas AREAS.toml"
+                    .into(),
             ));
         }
         match self.preset() {

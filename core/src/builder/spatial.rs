@@ -276,6 +276,20 @@ struct Boundary {
     n_right: u32,
 }
 
+impl Boundary {
+    /// Makes this boundary, as `split`, the `best` split so far when it is cheaper.
+    fn keep_if_cheaper(&self, split: Split, best: &mut Option<Priced>) {
+        if best.is_none_or(|b| self.cost < b.cost) {
+            *best = Some(Priced {
+                split,
+                cost: self.cost,
+                left: self.left,
+                right: self.right,
+            });
+        }
+    }
+}
+
 impl Sweep {
     const NEW: Sweep = Sweep {
         bins: [SweepBin::EMPTY; MAX_BINS as usize],
@@ -878,20 +892,14 @@ impl Run<'_> {
             else {
                 continue;
             };
-            if best.is_none_or(|b| c.cost < b.cost) {
-                best = Some(Priced {
-                    split: Split::Spatial {
-                        axis,
-                        bin: c.bin,
-                        grid,
-                        n_left: c.n_left,
-                        n_right: c.n_right,
-                    },
-                    cost: c.cost,
-                    left: c.left,
-                    right: c.right,
-                });
-            }
+            let split = Split::Spatial {
+                axis,
+                bin: c.bin,
+                grid,
+                n_left: c.n_left,
+                n_right: c.n_right,
+            };
+            c.keep_if_cheaper(split, &mut best);
         }
         best
     }
@@ -928,19 +936,13 @@ impl Run<'_> {
             else {
                 continue;
             };
-            if best.is_none_or(|b| c.cost < b.cost) {
-                best = Some(Priced {
-                    split: Split::Object {
-                        axis,
-                        bin: c.bin,
-                        offset,
-                        scale,
-                    },
-                    cost: c.cost,
-                    left: c.left,
-                    right: c.right,
-                });
-            }
+            let split = Split::Object {
+                axis,
+                bin: c.bin,
+                offset,
+                scale,
+            };
+            c.keep_if_cheaper(split, &mut best);
         }
         best
     }

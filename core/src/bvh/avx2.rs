@@ -15,9 +15,10 @@ use core::arch::x86_64::{
 };
 use core::ops::{Add, Mul, Sub};
 
-use super::traverse::Stack;
 use super::wide::{WideBvh8, WideBvhN};
-use super::wide_traverse::{wide_stack, ChildLanes, Counters, Entry, Lanes, LeafVisitor, Width};
+use super::wide_traverse::{
+    wide_stack, ChildLanes, Counters, Lanes, LeafVisitor, PendingArray, Width,
+};
 use super::Hit;
 use crate::geometry::{Ray, Triangle4};
 
@@ -104,7 +105,7 @@ pub(crate) struct Avx2Lanes8;
 
 impl Lanes<8> for Avx2Lanes8 {
     type V = Avx8;
-    type Pending = Stack<Entry, { wide_stack(8) }>;
+    type Pending = PendingArray<{ wide_stack(8) }>;
 }
 
 /// Whether 4-wide trees take the AVX2 entry points too: no. Their lanes stay `f32x4` (one SSE

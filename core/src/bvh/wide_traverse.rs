@@ -1,11 +1,11 @@
 //! Traversal of 4-wide BVHs: one loop ([`super::WideBvh::traverse`]) with one 4-wide slab test per node,
 //! and a leaf callback ([`LeafVisitor`]) that makes it closest hit, any hit or the all-hit count.
 
+use core::mem::MaybeUninit;
 use core::ops::{Add, Mul, Sub};
 
 use wide::{f32x4, f32x8};
 
-use super::traverse::Stack;
 use super::wide::{WideBvhN, WideNodeN};
 use super::{AllHitStats, Hit, TraversalStats, MAX_DEPTH};
 use crate::geometry::{pad_far, Ray, RayTri4, Triangle4};
@@ -16,28 +16,62 @@ pub(crate) const fn wide_stack(w: usize) -> usize {
     (w - 1) * MAX_DEPTH as usize + w
 }
 
-/// A traversal's stack of pending entries, sized per width ([`Lanes::Pending`]).
+/// The storage of a traversal's pending entries, sized per width ([`Lanes::Pending`]), left
+/// uninitialised (only the used part is ever written). The walk counts the entries in a local of
+/// its own: a count in one struct with the dynamically indexed array stayed in
+/// memory, a store and a reload on every push and pop.
 pub trait Pending {
-    /// An empty stack.
+    /// Empty storage.
     fn new() -> Self;
-    /// Pushes an entry (panics past the depth bound's size, which a valid tree never reaches).
-    fn push(&mut self, entry: Entry);
-    /// Pops the last entry pushed.
-    fn pop(&mut self) -> Option<Entry>;
+    /// Writes `entry` to slot `i` (panics past the depth bound's size, which a valid tree never
+    /// reaches).
+    fn put(&mut self, i: usize, entry: Entry);
+    /// The entry in slot `i`.
+    ///
+    /// # Safety
+    ///
+    /// Slot `i` was written by [`Pending::put`].
+    unsafe fn get(&self, i: usize) -> Entry;
 }
 
-impl<const N: usize> Pending for Stack<Entry, N> {
+/// Storage for `N` pending entries.
+pub struct PendingArray<const N: usize>([MaybeUninit<Entry>; N]);
+
+impl<const N: usize> Pending for PendingArray<N> {
     #[inline(always)]
     fn new() -> Self {
-        Stack::new()
+        Self([const { MaybeUninit::uninit() }; N])
     }
     #[inline(always)]
+    fn put(&mut self, i: usize, entry: Entry) {
+        // Bounds-checked: never writes out of bounds.
+        self.0[i].write(entry);
+    }
+    #[inline(always)]
+    unsafe fn get(&self, i: usize) -> Entry {
+        // SAFETY: the caller says slot `i` was written; `Entry: Copy`, nothing to drop.
+        unsafe { self.0.get_unchecked(i).assume_init() }
+    }
+}
+
+/// A stack over [`Pending`] storage with its count beside it: the walk's pending subtrees.
+struct PendingStack<'a, P> {
+    items: &'a mut P,
+    len: usize,
+}
+
+impl<P: Pending> PendingStack<'_, P> {
+    #[inline(always)]
     fn push(&mut self, entry: Entry) {
-        Stack::push(self, entry)
+        self.items.put(self.len, entry);
+        self.len += 1;
     }
     #[inline(always)]
     fn pop(&mut self) -> Option<Entry> {
-        Stack::pop(self)
+        self.len = self.len.checked_sub(1)?;
+        // SAFETY: slot `len` (the new `len`) was written by the push that raised `len` above it;
+        // only `push` writes and only `pop` lowers `len`.
+        Some(unsafe { self.items.get(self.len) })
     }
 }
 
@@ -157,12 +191,12 @@ pub trait Lanes<const W: usize> {
 
 impl Lanes<4> for Width<4> {
     type V = f32x4;
-    type Pending = Stack<Entry, { wide_stack(4) }>;
+    type Pending = PendingArray<{ wide_stack(4) }>;
 }
 
 impl Lanes<8> for Width<8> {
     type V = f32x8;
-    type Pending = Stack<Entry, { wide_stack(8) }>;
+    type Pending = PendingArray<{ wide_stack(8) }>;
 }
 
 /// A ray prepared for `W`-wide box tests, once per query: splatted origin and inverse direction,
@@ -664,7 +698,11 @@ where
         stats: &mut impl Counters,
     ) -> bool {
         let r = RayN::<L::V>::new(ray);
-        let mut stack = L::Pending::new();
+        let mut storage = L::Pending::new();
+        let mut stack = PendingStack {
+            items: &mut storage,
+            len: 0,
+        };
         let (mut child, mut count) = (root, 0u32);
         loop {
             if count == 0 {
@@ -755,7 +793,7 @@ impl<const W: usize> WideBvhN<W> {
 /// farthest first, and returns the nearest.
 #[inline(always)]
 fn push_ordered<const W: usize, V: ChildLanes<W>>(
-    stack: &mut impl Pending,
+    stack: &mut PendingStack<'_, impl Pending>,
     node: &WideNodeN<W>,
     t_near: V,
     first: usize,

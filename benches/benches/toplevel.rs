@@ -16,6 +16,8 @@
 //! ray and the mean traversal cost per ray (inner nodes + triangle tests) of each is printed.
 //! `query/SCENE/AREA/{structure,fallback}-wide`: the same after `TopLevel::widen` (4-wide local and
 //! fallback BVHs), checked ray by ray against the binary scene first.
+//! `query/SCENE/AREA/lookup-clip`: what every query through the structure pays before it touches
+//! a tree (`TopLevel::affine_segments`: the octree lookup, the affinity test and the clip).
 //!
 //! Clock per `RDBVH_BENCH_CLOCK` (thread CPU time by default).
 
@@ -182,6 +184,15 @@ fn query(c: &mut Criterion<Clock>) {
                         .iter()
                         .filter(|r| scene.closest_hit(r, &tris).is_some())
                         .count()
+                })
+            });
+            // What every query pays before any tree: the lookup, the affinity test and the clip.
+            group.bench_function("lookup-clip", |bench| {
+                bench.iter(|| {
+                    black_box(&rays)
+                        .iter()
+                        .map(|r| scene.affine_segments(r).count())
+                        .sum::<usize>()
                 })
             });
             let fallback = scene.fallback();

@@ -309,10 +309,12 @@ impl<L: AreaLookup, T: Traversable> TopLevel<L, T> {
             + self.areas.len() * core::mem::size_of::<InfluenceArea>()
     }
 
-    /// The local segments to search: for each of up to `max_tries` affine candidate areas (the
-    /// origin is inside), the area and where the segment leaves it.
+    /// The local segments a query searches before the fallback BVH: for each of up to
+    /// `max_tries` affine candidate areas (the origin is inside), the area and where the segment
+    /// leaves it. This is the structure's per-ray overhead (the lookup, the affinity test and the
+    /// clip), public so that it can be measured and a caller can see which area a ray goes to.
     #[inline]
-    fn affine_segments<'a>(&'a self, ray: &'a Ray) -> impl Iterator<Item = (u32, f32)> + 'a {
+    pub fn affine_segments<'a>(&'a self, ray: &'a Ray) -> impl Iterator<Item = (u32, f32)> + 'a {
         self.lookup
             .candidates(ray.origin)
             .iter()

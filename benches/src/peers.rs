@@ -34,8 +34,11 @@
 //!   (`embree-high`, `tinybvh8-hq`): a spatial-split (SBVH) build of rdbvh is compared with
 //!   those, not with trees built without splits.
 
+use std::marker::PhantomData;
+
 use glam::{Vec3, Vec3A};
 use rdbvh_core::builder::{reinsert, Builder, ReinsertConfig};
+use rdbvh_core::bvh::{Lanes, WideBvhN, Width};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::heuristics::Sah;
 
@@ -152,13 +155,10 @@ impl Library for Rdbvh {
         rays.to_vec()
     }
     fn build(scene: &mut Self::Scene) -> Self::Accel {
-        Builder::sah()
-            .build(scene)
-            .expect("scene triangles are finite")
+        BinnedSah::binary(scene)
     }
     fn build_mt(scene: &mut Self::Scene) -> Self::Accel {
-        rdbvh_core::builder::parallel::build(&Builder::sah(), scene)
-            .expect("scene triangles are finite")
+        BinnedSah::binary_mt(scene)
     }
     #[inline]
     fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Ray) -> Option<f32> {
@@ -170,93 +170,92 @@ impl Library for Rdbvh {
     }
 }
 
-/// rdbvh's 4-wide BVH, as a renderer that traces many rays per build would make it: the binary
-/// SAH tree, improved by reinsertion ([`rdbvh_core::builder::reinsert`], default settings, under
-/// SAH), then collapsed into nodes whose four child boxes are tested with one SIMD slab test, with
-/// its own copy of the triangles in 4-wide leaf blocks (issue 6). Its build time includes all
-/// three steps; its traversals use that copy, not the scene.
-pub struct RdbvhWide;
+/// One of rdbvh's wide trees as a [`Library`]: a binary tree made by `R`, improved by
+/// reinsertion ([`rdbvh_core::builder::reinsert`], default settings, under SAH) and collapsed into
+/// `W`-wide nodes with its own copy of the triangles in 4-wide leaf blocks, as a renderer that
+/// traces many rays per build would make it. Its build time includes all three steps; its
+/// traversals use that copy, not the scene.
+pub struct RdbvhWideOf<R, const W: usize>(PhantomData<R>);
 
-impl Library for RdbvhWide {
-    const NAME: &'static str = "rdbvh-wide";
-    const PARALLEL_BUILD: Option<&'static str> =
-        Some("rdbvh_core::builder::parallel::build, then the single-threaded reinsertion and 4-wide collapse");
-    type Scene = Vec<Triangle>;
-    type Ray = Ray;
-    type Accel = rdbvh_core::bvh::WideBvh;
-
-    fn scene(tris: &[Triangle]) -> Self::Scene {
-        tris.to_vec()
-    }
-    fn rays(rays: &[Ray]) -> Vec<Ray> {
-        rays.to_vec()
-    }
-    fn build(scene: &mut Self::Scene) -> Self::Accel {
-        wide_from(Rdbvh::build(scene), scene)
-    }
-    fn build_mt(scene: &mut Self::Scene) -> Self::Accel {
-        wide_from(Rdbvh::build_mt(scene), scene)
-    }
-    #[inline]
-    fn closest(accel: &Self::Accel, _scene: &Self::Scene, ray: &Ray) -> Option<f32> {
-        accel.closest_hit(ray).map(|h| h.t)
-    }
-    #[inline]
-    fn any(accel: &Self::Accel, _scene: &Self::Scene, ray: &Ray) -> bool {
-        accel.any_hit(ray)
+/// What differs between rdbvh's wide trees: the binary build before the reinsertion and the
+/// collapse.
+pub trait BinaryRecipe {
+    /// The wide tree's name in benchmark ids and the results table, per width.
+    const NAMES: [&'static str; 2];
+    /// How [`BinaryRecipe::binary_mt`] uses threads (see [`Library::PARALLEL_BUILD`]).
+    const PARALLEL_BUILD: Option<&'static str>;
+    /// The binary tree, on one thread.
+    fn binary(tris: &[Triangle]) -> rdbvh_core::bvh::Bvh;
+    /// The binary tree, threaded where the recipe has a threaded build.
+    fn binary_mt(tris: &[Triangle]) -> rdbvh_core::bvh::Bvh {
+        Self::binary(tris)
     }
 }
 
-/// [`RdbvhWide`]'s binary tree collapsed to 8-wide nodes ([`rdbvh_core::bvh::WideBvh8`]): half
-/// the levels, so half the dependent node fetches on a ray's path.
-pub struct RdbvhWide8;
+/// rdbvh's binned SAH build, the tree of [`Rdbvh`].
+pub struct BinnedSah;
 
-impl Library for RdbvhWide8 {
-    const NAME: &'static str = "rdbvh-wide8";
-    const PARALLEL_BUILD: Option<&'static str> =
-        Some("rdbvh_core::builder::parallel::build, then the single-threaded reinsertion and 8-wide collapse");
-    type Scene = Vec<Triangle>;
-    type Ray = Ray;
-    type Accel = rdbvh_core::bvh::WideBvh8;
-
-    fn scene(tris: &[Triangle]) -> Self::Scene {
-        tris.to_vec()
+impl BinaryRecipe for BinnedSah {
+    const NAMES: [&'static str; 2] = ["rdbvh-wide", "rdbvh-wide8"];
+    const PARALLEL_BUILD: Option<&'static str> = Some(
+        "rdbvh_core::builder::parallel::build, then the single-threaded reinsertion and collapse",
+    );
+    fn binary(tris: &[Triangle]) -> rdbvh_core::bvh::Bvh {
+        Builder::sah()
+            .build(tris)
+            .expect("scene triangles are finite")
     }
-    fn rays(rays: &[Ray]) -> Vec<Ray> {
-        rays.to_vec()
-    }
-    fn build(scene: &mut Self::Scene) -> Self::Accel {
-        let mut bvh = Rdbvh::build(scene);
-        reinsert(&mut bvh, &Sah, &ReinsertConfig::default());
-        rdbvh_core::bvh::WideBvh8::from_binary(&bvh, scene)
-    }
-    fn build_mt(scene: &mut Self::Scene) -> Self::Accel {
-        let mut bvh = Rdbvh::build_mt(scene);
-        reinsert(&mut bvh, &Sah, &ReinsertConfig::default());
-        rdbvh_core::bvh::WideBvh8::from_binary(&bvh, scene)
-    }
-    #[inline]
-    fn closest(accel: &Self::Accel, _scene: &Self::Scene, ray: &Ray) -> Option<f32> {
-        accel.closest_hit(ray).map(|h| h.t)
-    }
-    #[inline]
-    fn any(accel: &Self::Accel, _scene: &Self::Scene, ray: &Ray) -> bool {
-        accel.any_hit(ray)
+    fn binary_mt(tris: &[Triangle]) -> rdbvh_core::bvh::Bvh {
+        rdbvh_core::builder::parallel::build(&Builder::sah(), tris)
+            .expect("scene triangles are finite")
     }
 }
 
 /// rdbvh's SBVH ([`rdbvh_core::builder::SpatialBuilder`], default settings: spatial splits with
-/// up to half as many references again), improved by reinsertion under SAH and collapsed to
-/// 8-wide nodes: [`RdbvhWide8`] with split triangles, the counterpart of `embree-high` and
-/// `tinybvh8-hq`. The spatial-split build runs on one thread.
-pub struct RdbvhWide8Sbvh;
+/// up to half as many references again), the counterpart of `embree-high` and `tinybvh8-hq`.
+/// The spatial-split build runs on one thread.
+pub struct Sbvh;
 
-impl Library for RdbvhWide8Sbvh {
-    const NAME: &'static str = "rdbvh-wide8-sbvh";
+impl BinaryRecipe for Sbvh {
+    const NAMES: [&'static str; 2] = ["rdbvh-wide-sbvh", "rdbvh-wide8-sbvh"];
     const PARALLEL_BUILD: Option<&'static str> = None;
+    fn binary(tris: &[Triangle]) -> rdbvh_core::bvh::Bvh {
+        rdbvh_core::builder::SpatialBuilder::default()
+            .build(tris)
+            .expect("scene triangles are finite")
+    }
+}
+
+/// rdbvh's 4-wide tree over its binned SAH build.
+pub type RdbvhWide = RdbvhWideOf<BinnedSah, 4>;
+
+/// [`RdbvhWide`]'s binary tree collapsed to 8-wide nodes ([`rdbvh_core::bvh::WideBvh8`]): half
+/// the levels, so half the dependent node fetches on a ray's path.
+pub type RdbvhWide8 = RdbvhWideOf<BinnedSah, 8>;
+
+/// [`RdbvhWide8`] over an SBVH: split triangles.
+pub type RdbvhWide8Sbvh = RdbvhWideOf<Sbvh, 8>;
+
+impl<R: BinaryRecipe, const W: usize> RdbvhWideOf<R, W>
+where
+    Width<W>: Lanes<W>,
+{
+    /// `bvh` improved by reinsertion under SAH, collapsed to `W`-wide nodes over `tris`.
+    fn widen(mut bvh: rdbvh_core::bvh::Bvh, tris: &[Triangle]) -> WideBvhN<W> {
+        reinsert(&mut bvh, &Sah, &ReinsertConfig::default());
+        WideBvhN::from_binary(&bvh, tris)
+    }
+}
+
+impl<R: BinaryRecipe, const W: usize> Library for RdbvhWideOf<R, W>
+where
+    Width<W>: Lanes<W>,
+{
+    const NAME: &'static str = R::NAMES[(W == 8) as usize];
+    const PARALLEL_BUILD: Option<&'static str> = R::PARALLEL_BUILD;
     type Scene = Vec<Triangle>;
     type Ray = Ray;
-    type Accel = rdbvh_core::bvh::WideBvh8;
+    type Accel = WideBvhN<W>;
 
     fn scene(tris: &[Triangle]) -> Self::Scene {
         tris.to_vec()
@@ -265,14 +264,10 @@ impl Library for RdbvhWide8Sbvh {
         rays.to_vec()
     }
     fn build(scene: &mut Self::Scene) -> Self::Accel {
-        let mut bvh = rdbvh_core::builder::SpatialBuilder::default()
-            .build(scene)
-            .expect("scene triangles are finite");
-        reinsert(&mut bvh, &Sah, &ReinsertConfig::default());
-        rdbvh_core::bvh::WideBvh8::from_binary(&bvh, scene)
+        Self::widen(R::binary(scene), scene)
     }
     fn build_mt(scene: &mut Self::Scene) -> Self::Accel {
-        Self::build(scene)
+        Self::widen(R::binary_mt(scene), scene)
     }
     #[inline]
     fn closest(accel: &Self::Accel, _scene: &Self::Scene, ray: &Ray) -> Option<f32> {
@@ -282,12 +277,6 @@ impl Library for RdbvhWide8Sbvh {
     fn any(accel: &Self::Accel, _scene: &Self::Scene, ray: &Ray) -> bool {
         accel.any_hit(ray)
     }
-}
-
-/// `bvh` improved by reinsertion under SAH, collapsed to 4-wide nodes over `tris`.
-fn wide_from(mut bvh: rdbvh_core::bvh::Bvh, tris: &[Triangle]) -> rdbvh_core::bvh::WideBvh {
-    reinsert(&mut bvh, &Sah, &ReinsertConfig::default());
-    rdbvh_core::bvh::WideBvh::from_binary(&bvh, tris)
 }
 
 fn obvhs_scene(tris: &[Triangle]) -> Vec<obvhs::triangle::Triangle> {

@@ -208,6 +208,9 @@ struct RayN<V> {
     near: [usize; 3],
     far: [usize; 3],
     t_min: V,
+    /// `t_min >= 0`, as for nearly every ray: every entry distance is then at least zero, and
+    /// the padding one product each way (see [`RayN::intersect`]).
+    forward: bool,
 }
 
 /// A node's bounds as rows: `min` of axes 0 to 2, then `max` of axes 0 to 2 (then `child` and
@@ -233,13 +236,19 @@ impl<V> RayN<V> {
             near: core::array::from_fn(|k| if ray.inv_dir[k] >= 0.0 { k } else { k + 3 }),
             far: core::array::from_fn(|k| if ray.inv_dir[k] >= 0.0 { k + 3 } else { k }),
             t_min: s(ray.t_min),
+            forward: ray.t_min >= 0.0,
         }
     }
 
     /// Entry distances of the children and the bitmask of those the segment up to `t_max`
-    /// touches. Same arithmetic as the scalar `Aabb::slab_interval`: the reduction keeps its
-    /// accumulator where a slab value is NaN (a zero direction component with the origin on a
-    /// slab plane), and the interval is padded after Ize.
+    /// touches. The slab values and their reduction are the scalar `Aabb::slab_interval`'s: the
+    /// reduction keeps its accumulator where a slab value is NaN (a zero direction component
+    /// with the origin on a slab plane). The interval is padded after Ize by the same relative
+    /// margin, but for a segment with `t_min >= 0` as Ize writes it, `t_near (1 - pad)` and
+    /// `t_far (1 + pad)`: one multiply each instead of an absolute value, a multiply and an add,
+    /// on the path from a node's load to the next node's address (+1-4% on `trace_profile`'s
+    /// measures). `t_near` is then at least zero, so the product shrinks it as the general form
+    /// does; a negative `t_far` stays below it either way, so the box is missed either way.
     #[inline(always)]
     fn intersect<const W: usize>(&self, node: &WideNodeN<W>, t_max: f32) -> (V, u32)
     where
@@ -254,9 +263,12 @@ impl<V> RayN<V> {
             t_near = t_near.keep_max((V::load(near) - self.origin[k]) * self.inv[k]);
             t_far = t_far.keep_min((V::load(far) - self.origin[k]) * self.inv[k]);
         }
-        let pad = V::splat(PAD);
-        let t_near = t_near - t_near.abs() * pad;
-        let t_far = t_far + t_far.abs() * pad;
+        let (t_near, t_far) = if self.forward {
+            (t_near * V::splat(1.0 - PAD), t_far * V::splat(1.0 + PAD))
+        } else {
+            let pad = V::splat(PAD);
+            (t_near - t_near.abs() * pad, t_far + t_far.abs() * pad)
+        };
         (t_near, t_near.le_bitmask(t_far))
     }
 }

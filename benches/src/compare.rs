@@ -21,9 +21,8 @@
 //! **The JSON contract.** [`Report::json_lines`] prints one object per line with exactly the
 //! keys `library` ([`LIBRARIES`]), `measure` ([`Measure::name`]), `value` and `unit`
 //! (`Mtris/s` or `Mrays/s`). obvhs is measured twice (its binary tree and its 8-wide compressed
-//! tree); under `obvhs`, builds report its binary-tree build (its fastest, the one issue 6's
-//! build target must beat) and each traversal reports the faster of the two trees, which the
-//! text output names.
+//! tree); under `obvhs`, builds report its binary-tree build (its fastest) and each traversal
+//! reports the faster of the two trees, which the text output names.
 
 use std::fmt::Write as _;
 use std::time::{Duration, Instant};

@@ -6,9 +6,9 @@
 //! - **rdbvh**: `Builder::sah()` (binned SAH, all three axes, 16 bins, SAH termination with leaves
 //!   up to 8), single-threaded; binary-node closest hit and any hit. `rdbvh-wide` is the same
 //!   tree improved by reinsertion (as obvhs's build improves its own) and collapsed to 4-wide
-//!   nodes (issue 6): the tree for tracing many rays per build.
-//! - **obvhs 0.4**: `BvhBuildParams::fast_build()` as issue 2 asks, through the crate's own
-//!   helpers. obvhs does not build with binned SAH: its builder is PLOC (agglomerative clustering
+//!   nodes: the tree for tracing many rays per build.
+//! - **obvhs 0.4**: `BvhBuildParams::fast_build()`, its fast high-quality build, through the
+//!   crate's own helpers. obvhs does not build with binned SAH: its builder is PLOC (agglomerative clustering
 //!   over a Morton order) plus a little reinsertion, so "SAH build" here means "its fast
 //!   high-quality build". It is measured twice: `obvhs-bvh2` (`build_bvh2_from_tris`, its binary
 //!   tree, the same node kind as rdbvh) and `obvhs-cwbvh` (`build_cwbvh_from_tris`, its

@@ -1,4 +1,4 @@
-//! Property tests of influence areas and the scene structure (issues 3 and 4):
+//! Property tests of influence areas and the scene structure:
 //! - the exact separating-axis test agrees with a sampling oracle: a triangle with a sampled point
 //!   inside an area always overlaps it, and a triangle said to be apart has no point inside;
 //! - the octree is conservative: a point inside an area always finds the area in its leaf;

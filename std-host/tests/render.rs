@@ -163,6 +163,27 @@ fn json_has_the_contract_keys() {
     assert_eq!((png.width(), png.height()), (40, 32));
 }
 
+/// Without `--eye` and `--look-at` the closed room is seen from its own view, inside, exactly as
+/// with that view given (framed from outside it would show only its unlit outer walls).
+#[test]
+fn a_scene_without_a_camera_uses_its_own_view() {
+    let dir = scratch("own-view");
+    let small = ["--width", "40", "--height", "32", "--spp", "2"];
+    let own = render(
+        &["builtin:room", "--fov", "75"],
+        &dir.join("own.png"),
+        &small,
+    );
+    let given = render(&ROOM[..7], &dir.join("given.png"), &small);
+    assert!(own["mean_luminance"].as_f64().unwrap() > 0.05, "{own}");
+    assert!(own["shadow_rays"].as_u64().unwrap() > 0, "{own}");
+    assert_eq!(
+        std::fs::read(dir.join("own.png")).unwrap(),
+        std::fs::read(dir.join("given.png")).unwrap()
+    );
+    assert_eq!(own["mean_luminance"], given["mean_luminance"]);
+}
+
 #[test]
 fn recorded_rays_replay_through_trace_and_agree_with_brute_force() {
     let dir = scratch("record");

@@ -51,10 +51,12 @@ pub struct RenderArgs {
     /// Worker threads (0: every core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// The camera's position [default: in front of the scene's +z face, framing its bounds]
+    /// The camera's position [default: the scene's own view (builtin:room: inside, by the front
+    /// wall), else in front of the scene's +z face, framing its bounds]
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub eye: Option<Vec3>,
-    /// The point the camera looks at [default: the centre of the scene's bounds]
+    /// The point the camera looks at [default: the scene's own view, else the centre of its
+    /// bounds]
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub look_at: Option<Vec3>,
     /// The image's up direction [default: 0,1,0]
@@ -203,11 +205,17 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
     let lights = LightSet::new(lights, &scene.triangles).ok_or_else(|| RenderError::NoLights {
         scene: scene.name.clone(),
     })?;
-    let framing = Camera::framing(scene.bounds, args.fov, args.width, args.height)?;
+    let (eye, look_at) = match scene.view {
+        Some(view) => (view.eye, view.look_at),
+        None => (
+            Camera::framing(scene.bounds, args.fov, args.width, args.height)?.eye(),
+            scene.bounds.center(),
+        ),
+    };
     let camera_of = |(width, height)| {
         Camera::new(
-            args.eye.unwrap_or(framing.eye()),
-            args.look_at.unwrap_or(scene.bounds.center()),
+            args.eye.unwrap_or(eye),
+            args.look_at.unwrap_or(look_at),
             args.up.unwrap_or(Vec3::Y),
             args.fov,
             width,

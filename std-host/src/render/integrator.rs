@@ -241,6 +241,7 @@ mod tests {
             }],
             warnings: vec![],
             material_files: vec![],
+            view: None,
         }
     }
 

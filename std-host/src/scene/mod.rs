@@ -19,6 +19,7 @@ pub use procedural::{thesis_random_triangles, THESIS_SEED};
 pub use room::room;
 
 use rdbvh_core::geometry::{Aabb, Triangle};
+use rdbvh_core::Vec3;
 
 /// A material as far as ray distribution and the renderer care: its name, its diffuse colour and
 /// how much light it emits.
@@ -64,6 +65,19 @@ pub struct Scene {
     /// The material library files that were read from disk, so that a command can refuse to
     /// write its output over one. Empty for built-in and in-memory scenes.
     pub material_files: Vec<std::path::PathBuf>,
+    /// Where a camera should stand and look when the user names none: set by a scene that a
+    /// camera framing its bounds from outside would not show (the closed built-in room); `None`
+    /// for OBJ files.
+    pub view: Option<View>,
+}
+
+/// A scene's own camera placement (see [`Scene::view`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    /// The camera's position.
+    pub eye: Vec3,
+    /// The point it looks at.
+    pub look_at: Vec3,
 }
 
 impl Scene {

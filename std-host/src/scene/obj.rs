@@ -247,6 +247,7 @@ impl Scene {
             bounds,
             warnings,
             material_files: read_files.into_inner(),
+            view: None,
         })
     }
 }

@@ -52,6 +52,7 @@ pub(super) fn random_scene(name: &str, skip: usize, count: usize) -> Scene {
         bounds,
         warnings: Vec::new(),
         material_files: Vec::new(),
+        view: None,
         triangles,
     }
 }

@@ -5,7 +5,7 @@
 use rdbvh_core::geometry::{Aabb, Triangle};
 use rdbvh_core::Vec3;
 
-use super::{Material, Scene, BUILTIN_PREFIX};
+use super::{Material, Scene, View, BUILTIN_PREFIX};
 
 /// Edge length of the room, which spans `[0, ROOM_SIZE]^3` with `y` up.
 pub const ROOM_SIZE: f32 = 10.0;
@@ -69,6 +69,12 @@ pub fn room() -> Scene {
         materials,
         warnings: Vec::new(),
         material_files: Vec::new(),
+        // From inside, by the front wall, looking at the back wall over the boxes: the room is
+        // closed, and a camera framing it from outside would see only its unlit outer walls.
+        view: Some(View {
+            eye: Vec3::new(5.0, 5.0, 0.3),
+            look_at: Vec3::new(5.0, 4.0, 10.0),
+        }),
     }
 }
 

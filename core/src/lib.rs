@@ -32,6 +32,8 @@
 //! | [`light_buffer`] | a shadow-ray structure around one light, cells of the light's view | |
 //! | [`analyze`] | the composable BVH analyzer, estimated and measured cost, EPO, overlap | analyzer |
 //!
+//! Beside them, [`prefetch`]: a cache hint for what a renderer reads after a hit (its materials).
+//!
 //! Features: `std` (off) lets x86-64 builds choose the wide traversals' instructions at run time
 //! (AVX2 where the CPU has it: [`bvh::simd_level`]); `rayon` (off) builds on every thread of
 //! rayon's pool and implies `std`. Without them the crate is `no_std` + `alloc`.
@@ -52,6 +54,7 @@ pub mod geometry;
 pub mod heuristics;
 pub mod influence;
 pub mod light_buffer;
+mod prefetch;
 pub mod random;
 pub mod simd;
 pub mod toplevel;
@@ -65,4 +68,5 @@ pub use error::BuildError;
 pub use geometry::{Aabb, Ray, Triangle};
 pub use glam::Vec3;
 pub use influence::{InfluenceArea, PlaneArea, PointArea};
+pub use prefetch::prefetch;
 pub use toplevel::{TopLevel, TopLevelOptions};

@@ -21,7 +21,9 @@ pub use traverse::{AllHitStats, Hit, TraversalStats};
 pub use validate::InvariantError;
 pub use wide::{WideBvh, WideBvh8, WideBvhN, WideNode, WideNode8, WideNodeN};
 pub(crate) use wide_traverse::Counters;
-pub use wide_traverse::{AnyHit, ChildLanes, ClosestHit, HitCount, Lanes, LeafVisitor, Width};
+pub use wide_traverse::{
+    AnyHit, ChildLanes, ClosestHit, ClosestHitEdges, HitCount, Lanes, LeafVisitor, Width,
+};
 
 use crate::geometry::Aabb;
 use crate::heuristics::{CostConstants, CostModel};

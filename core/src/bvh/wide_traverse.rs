@@ -8,7 +8,7 @@ use wide::{f32x4, f32x8};
 
 use super::wide::{WideBvhN, WideNodeN};
 use super::{AllHitStats, Hit, TraversalStats, MAX_DEPTH};
-use crate::geometry::{pad_far, Ray, RayTri4, Triangle4};
+use crate::geometry::{pad_far, Ray, RayTri4, Triangle4, TriangleEdges};
 
 /// The pending entries of a `W`-wide traversal: each visited node pops one entry and pushes at
 /// most `W`, so they grow by at most `W - 1` per level of the (at most [`MAX_DEPTH`] deep) tree.
@@ -382,20 +382,73 @@ impl LeafVisitor for ClosestHit {
     #[inline(always)]
     fn leaf(&mut self, blocks: &[Triangle4], _count: u32) -> bool {
         for block in blocks {
-            let h = block.intersect(&self.ray, self.t_max);
-            let mut m = h.mask;
-            while m != 0 {
-                let j = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let hit = Hit {
-                    t: h.t[j],
-                    triangle: block.id[j],
-                    u: h.u[j],
-                    v: h.v[j],
-                };
-                if self.best.is_none_or(|b| hit.is_closer_than(&b)) {
-                    self.best = Some(hit);
-                    self.t_max = hit.t;
+            self.take(block);
+        }
+        false
+    }
+}
+
+impl ClosestHit {
+    /// Tests `block` and keeps the closest of its hits under the tie rule; returns the lane that
+    /// became the closest hit last, if any did.
+    #[inline(always)]
+    fn take(&mut self, block: &Triangle4) -> Option<usize> {
+        let h = block.intersect(&self.ray, self.t_max);
+        let mut m = h.mask;
+        let mut taken = None;
+        while m != 0 {
+            let j = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let hit = Hit {
+                t: h.t[j],
+                triangle: block.id[j],
+                u: h.u[j],
+                v: h.v[j],
+            };
+            if self.best.is_none_or(|b| hit.is_closer_than(&b)) {
+                self.best = Some(hit);
+                self.t_max = hit.t;
+                taken = Some(j);
+            }
+        }
+        taken
+    }
+}
+
+/// Closest hit that also keeps the hit triangle's first vertex and edges from its leaf block
+/// ([`TriangleEdges`]), for a renderer that shades the hit: the block was just read, the scene's
+/// triangle array usually was not.
+pub struct ClosestHitEdges {
+    closest: ClosestHit,
+    /// The closest hit so far and its triangle.
+    pub best: Option<(Hit, TriangleEdges)>,
+}
+
+impl ClosestHitEdges {
+    /// A query along `ray`, nothing hit yet.
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> Self {
+        Self {
+            closest: ClosestHit::new(ray),
+            best: None,
+        }
+    }
+}
+
+impl LeafVisitor for ClosestHitEdges {
+    const ORDERED: bool = true;
+
+    #[inline(always)]
+    fn t_max(&self) -> f32 {
+        self.closest.t_max
+    }
+
+    #[inline(always)]
+    fn leaf(&mut self, blocks: &[Triangle4], _count: u32) -> bool {
+        for block in blocks {
+            if let Some(j) = self.closest.take(block) {
+                if let Some(hit) = self.closest.best {
+                    self.best = Some((hit, block.edges(j)));
                 }
             }
         }
@@ -537,6 +590,15 @@ where
     /// root's box by visits none: see `WideBvh::misses_root`).
     pub fn closest_hit_with_stats(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
         self.closest(ray, stats)
+    }
+
+    /// [`WideBvhN::closest_hit`] with the hit triangle's first vertex and edges from its leaf
+    /// block (see [`TriangleEdges`]): the same hit, and what a renderer needs to shade it without
+    /// another trip to memory.
+    pub fn closest_hit_edges(&self, ray: &Ray) -> Option<(Hit, TriangleEdges)> {
+        let mut visitor = ClosestHitEdges::new(ray);
+        self.traverse(ray, &mut visitor);
+        visitor.best
     }
 
     /// True when the ray surely misses every child of the root, decided before any set-up.
@@ -902,6 +964,36 @@ mod tests {
                 assert_eq!(wide8.all_hit(&r).hits, brute_force::hit_count(&r, tris));
             }
         }
+    }
+
+    /// The hit with edges is the closest hit, and its edges are the scene triangle's first
+    /// vertex and `v1 - v0`, `v2 - v0` bit for bit, on 4- and 8-wide trees.
+    #[test]
+    fn closest_hit_edges_are_the_hit_triangles() {
+        let tris = crate::test_scenes::soup(900, 31, -10.0, 10.0, 1.5);
+        let bvh = Builder::sah().build(&tris).unwrap();
+        let wide = WideBvh::from_binary(&bvh, &tris);
+        let wide8 = crate::bvh::WideBvh8::from_binary(&bvh, &tris);
+        let mut rng = Pcg32::new(32);
+        let mut hits = 0;
+        for _ in 0..3000 {
+            let mut v = |s: f32| Vec3::new(rng.range(-s, s), rng.range(-s, s), rng.range(-s, s));
+            let Ok(r) = Ray::new(v(12.0), v(1.0)) else {
+                continue;
+            };
+            for found in [wide.closest_hit_edges(&r), wide8.closest_hit_edges(&r)] {
+                assert_eq!(found.map(|(h, _)| h), wide.closest_hit(&r));
+                if let Some((h, e)) = found {
+                    let t = &tris[h.triangle as usize];
+                    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                    assert_eq!(bits(e.v0), bits(t.v0));
+                    assert_eq!(bits(e.e1), bits(t.v1 - t.v0));
+                    assert_eq!(bits(e.e2), bits(t.v2 - t.v0));
+                    hits += 1;
+                }
+            }
+        }
+        assert!(hits > 500, "{hits} hits");
     }
 
     #[test]

@@ -30,4 +30,4 @@ pub use ray::{Ray, RayError};
 pub(crate) use solid_angle::tests::{front_faces_f64, reference as box_solid_angle_f64};
 pub use solid_angle::{box_solid_angle4, box_solid_angle_far4, far_field4, FarFace, FAR_FIELD};
 pub use triangle::{Triangle, TriangleHit};
-pub use triangle4::{Hits4, RayTri4, Triangle4};
+pub use triangle4::{Hits4, RayTri4, Triangle4, TriangleEdges};

@@ -29,6 +29,21 @@ pub struct Triangle4 {
 
 static_assertions::assert_eq_size!(Triangle4, [u8; 160]);
 
+/// One lane of a [`Triangle4`]: a triangle as the intersection test sees it, its first vertex and
+/// the edges `e1 = v1 - v0`, `e2 = v2 - v0` (computed once by [`Triangle4::set`] with the scalar
+/// test's subtractions, so bit for bit `tri.v1 - tri.v0` and `tri.v2 - tri.v0`). A hit's point
+/// `v0 + e1 u + e2 v` and normal `e1 x e2` come from it without the scene's own triangle array,
+/// whose entry for the hit is usually not in the caches when the leaf's block is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleEdges {
+    /// The first vertex.
+    pub v0: Vec3,
+    /// `v1 - v0`.
+    pub e1: Vec3,
+    /// `v2 - v0`.
+    pub e2: Vec3,
+}
+
 /// The hits of a [`Triangle4`] test: the bitmask of lanes hit and their `t`, `u`, `v`.
 #[derive(Clone, Copy, Debug)]
 pub struct Hits4 {
@@ -106,6 +121,17 @@ impl Triangle4 {
         e2: [[0.0; 4]; 3],
         id: [Self::UNUSED_ID; 4],
     };
+
+    /// Lane `j`'s first vertex and edges.
+    #[inline]
+    pub fn edges(&self, j: usize) -> TriangleEdges {
+        let v = |rows: &[[f32; 4]; 3]| Vec3::new(rows[0][j], rows[1][j], rows[2][j]);
+        TriangleEdges {
+            v0: v(&self.v0),
+            e1: v(&self.e1),
+            e2: v(&self.e2),
+        }
+    }
 
     /// Puts triangle `tri` with id `id` in lane `j`.
     pub fn set(&mut self, j: usize, tri: &Triangle, id: u32) {

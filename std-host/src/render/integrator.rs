@@ -9,7 +9,7 @@ use std::f32::consts::{FRAC_1_PI, TAU};
 
 use rdbvh_core::bvh::{Hit, TraversalStats};
 use rdbvh_core::geometry::{Ray, Triangle};
-use rdbvh_core::Vec3;
+use rdbvh_core::{prefetch, Vec3};
 
 use super::sampler::{vertex_dim, Sampler};
 use super::{LightSet, RenderError, Structure};
@@ -112,15 +112,23 @@ impl<'a> Integrator<'a> {
         let mut throughput = Vec3::ONE;
         let mut ray = camera_ray;
         for depth in 0..=self.max_bounces {
-            let hit = self.structure.closest_hit(&ray);
-            observer.closest(depth, &ray, hit.as_ref());
-            let Some(hit) = hit else { break };
+            let found = self.structure.closest_hit(&ray);
+            observer.closest(depth, &ray, found.as_ref().map(|(hit, _)| hit));
+            let Some((hit, t)) = found else { break };
             let id = hit.triangle as usize;
-            let t = &self.triangles[id];
+            // The material's entries are read after the shadow segment (in the same order of
+            // additions): fetched now, they arrive while it is traced, where read here they
+            // were the costliest load of the shading.
+            prefetch(&self.albedo[id]);
+            if depth == 0 {
+                prefetch(&self.emission[id]);
+            }
             // The hit point from the barycentrics: on the triangle up to rounding, wherever the
-            // ray started.
-            let p = t.v0 + (t.v1 - t.v0) * hit.u + (t.v2 - t.v0) * hit.v;
-            let mut n = (t.v1 - t.v0).cross(t.v2 - t.v0).normalize_or_zero();
+            // ray started. The edges are the leaf block's, bit for bit `v1 - v0` and `v2 - v0`
+            // of the scene's triangle, which is not read: the block is in the caches, the
+            // triangle array's entry usually is not.
+            let p = t.v0 + t.e1 * hit.u + t.e2 * hit.v;
+            let mut n = t.e1.cross(t.e2).normalize_or_zero();
             if n == Vec3::ZERO {
                 break;
             }
@@ -128,10 +136,6 @@ impl<'a> Integrator<'a> {
             if n.dot(ray.dir) > 0.0 {
                 n = -n;
             }
-            if depth == 0 {
-                radiance += throughput * self.emission[id];
-            }
-            let albedo = self.albedo[id];
             let origin = p + n * self.offset;
             let dim = vertex_dim(depth);
 
@@ -142,6 +146,8 @@ impl<'a> Integrator<'a> {
                 sampler.get(dim + 1),
                 sampler.get(dim + 2),
             );
+            // The light sample's weight and geometric factor, when its segment is unoccluded.
+            let mut lit = None;
             if let Some(s) = sample {
                 let d = s.target - origin;
                 let cos = n.dot(d);
@@ -156,13 +162,17 @@ impl<'a> Integrator<'a> {
                         };
                         observer.shadow(&shadow, &stats);
                         if !occluded {
-                            radiance += throughput
-                                * albedo
-                                * s.weight
-                                * (FRAC_1_PI * cos / (d.length() * probability));
+                            lit = Some((s.weight, FRAC_1_PI * cos / (d.length() * probability)));
                         }
                     }
                 }
+            }
+            if depth == 0 {
+                radiance += throughput * self.emission[id];
+            }
+            let albedo = self.albedo[id];
+            if let Some((weight, geometry)) = lit {
+                radiance += throughput * albedo * weight * geometry;
             }
 
             if depth == self.max_bounces {

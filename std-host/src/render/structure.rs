@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use rdbvh_core::builder::{parallel, BuildOptions, Preset};
 use rdbvh_core::bvh::{Hit, TraversalStats, WideBvh8};
-use rdbvh_core::geometry::{Ray, Triangle};
+use rdbvh_core::geometry::{Ray, Triangle, TriangleEdges};
 use rdbvh_core::light_buffer::LightBuffer;
 
 use super::light_structure::light_buffers;
@@ -185,10 +185,11 @@ impl Structure {
         self.build_ms += ms;
     }
 
-    /// The closest hit of a camera or bounce ray: always the global BVH.
+    /// The closest hit of a camera or bounce ray, with its triangle's first vertex and edges
+    /// from the leaf block that held it: always the global BVH.
     #[inline]
-    pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
-        self.global().closest_hit(ray)
+    pub fn closest_hit(&self, ray: &Ray) -> Option<(Hit, TriangleEdges)> {
+        self.global().closest_hit_edges(ray)
     }
 
     /// Whether anything blocks the shadow segment `ray` toward light `light`.

@@ -246,9 +246,10 @@ impl<V> RayN<V> {
     /// with the origin on a slab plane). The interval is padded after Ize by the same relative
     /// margin, but for a segment with `t_min >= 0` as Ize writes it, `t_near (1 - pad)` and
     /// `t_far (1 + pad)`: one multiply each instead of an absolute value, a multiply and an add,
-    /// on the path from a node's load to the next node's address (up to 4% faster, benches/
-    /// RESULTS.md). `t_near` is then at least zero, so the product shrinks it as the general form
-    /// does; a negative `t_far` stays below it either way, so the box is missed either way.
+    /// on the path from a node's load to the next node's address (up to 4% faster; see
+    /// `benches/RESULTS.md`). `t_near` is then at least zero, so the product shrinks it as the
+    /// general form does; a negative `t_far` stays below it either way, so the box is missed
+    /// either way.
     #[inline(always)]
     fn intersect<const W: usize>(&self, node: &WideNodeN<W>, t_max: f32) -> (V, u32)
     where

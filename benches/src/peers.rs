@@ -279,101 +279,126 @@ where
     }
 }
 
-fn obvhs_scene(tris: &[Triangle]) -> Vec<obvhs::triangle::Triangle> {
-    tris.iter()
-        .map(|t| obvhs::triangle::Triangle {
-            v0: Vec3A::from(t.v0),
-            v1: Vec3A::from(t.v1),
-            v2: Vec3A::from(t.v2),
-        })
-        .collect()
+/// obvhs's two trees as far as the adapter uses them: the same methods on each, which obvhs
+/// declares on each type rather than in a trait.
+pub trait ObvhsTree: Sized {
+    /// The tree's name in benchmark ids and the results table.
+    const NAME: &'static str;
+    /// Builds the tree with `fast_build` on the current rayon pool.
+    fn build(scene: &mut [obvhs::triangle::Triangle]) -> Self;
+    /// Triangle index of each primitive slot.
+    fn primitive_indices(&self) -> &[u32];
+    /// obvhs's closest-hit traversal with `intersect` as the leaf test.
+    fn traverse(
+        &self,
+        ray: obvhs::ray::Ray,
+        hit: &mut obvhs::ray::RayHit,
+        intersect: impl FnMut(&obvhs::ray::Ray, usize) -> f32,
+    ) -> bool;
+    /// obvhs's any-hit traversal: true when nothing is hit.
+    fn traverse_miss(
+        &self,
+        ray: obvhs::ray::Ray,
+        intersect: impl FnMut(&obvhs::ray::Ray, usize) -> f32,
+    ) -> bool;
 }
 
-fn obvhs_rays(rays: &[Ray]) -> Vec<obvhs::ray::Ray> {
-    rays.iter()
-        .map(|r| obvhs::ray::Ray::new(Vec3A::from(r.origin), Vec3A::from(r.dir), r.t_min, r.t_max))
-        .collect()
+/// [`ObvhsTree`] for one of obvhs's trees: `$tree` built by `$build`, named `$name`.
+macro_rules! obvhs_tree {
+    ($tree:ty, $name:literal, $build:path) => {
+        impl ObvhsTree for $tree {
+            const NAME: &'static str = $name;
+            fn build(scene: &mut [obvhs::triangle::Triangle]) -> Self {
+                $build(
+                    scene,
+                    obvhs::BvhBuildParams::fast_build(),
+                    &mut Default::default(),
+                )
+            }
+            fn primitive_indices(&self) -> &[u32] {
+                &self.primitive_indices
+            }
+            #[inline]
+            fn traverse(
+                &self,
+                ray: obvhs::ray::Ray,
+                hit: &mut obvhs::ray::RayHit,
+                intersect: impl FnMut(&obvhs::ray::Ray, usize) -> f32,
+            ) -> bool {
+                self.ray_traverse(ray, hit, intersect)
+            }
+            #[inline]
+            fn traverse_miss(
+                &self,
+                ray: obvhs::ray::Ray,
+                intersect: impl FnMut(&obvhs::ray::Ray, usize) -> f32,
+            ) -> bool {
+                self.ray_traverse_miss(ray, intersect)
+            }
+        }
+    };
 }
 
-/// obvhs's binary tree from `fast_build` (PLOC + reinsertion + leaf collapse).
-pub struct ObvhsBvh2;
+obvhs_tree!(
+    obvhs::bvh2::Bvh2,
+    "obvhs-bvh2",
+    obvhs::bvh2::builder::build_bvh2_from_tris
+);
+obvhs_tree!(
+    obvhs::cwbvh::CwBvh,
+    "obvhs-cwbvh",
+    obvhs::cwbvh::builder::build_cwbvh_from_tris
+);
 
-impl Library for ObvhsBvh2 {
-    const NAME: &'static str = "obvhs-bvh2";
+/// obvhs's tree `T` from `fast_build` (PLOC + reinsertion + leaf collapse), with obvhs's own
+/// traversal and triangle test.
+pub struct Obvhs<T>(PhantomData<T>);
+
+/// obvhs's binary tree.
+pub type ObvhsBvh2 = Obvhs<obvhs::bvh2::Bvh2>;
+
+/// obvhs's 8-wide compressed tree, with its SIMD traversal.
+pub type ObvhsCwbvh = Obvhs<obvhs::cwbvh::CwBvh>;
+
+impl<T: ObvhsTree> Library for Obvhs<T> {
+    const NAME: &'static str = T::NAME;
     const PARALLEL_BUILD: Option<&'static str> =
         Some("the same call with obvhs's `parallel` feature on the all-thread rayon pool");
     type Scene = Vec<obvhs::triangle::Triangle>;
     type Ray = obvhs::ray::Ray;
-    type Accel = obvhs::bvh2::Bvh2;
+    type Accel = T;
 
     fn scene(tris: &[Triangle]) -> Self::Scene {
-        obvhs_scene(tris)
+        tris.iter()
+            .map(|t| obvhs::triangle::Triangle {
+                v0: Vec3A::from(t.v0),
+                v1: Vec3A::from(t.v1),
+                v2: Vec3A::from(t.v2),
+            })
+            .collect()
     }
     fn rays(rays: &[Ray]) -> Vec<Self::Ray> {
-        obvhs_rays(rays)
+        rays.iter()
+            .map(|r| {
+                obvhs::ray::Ray::new(Vec3A::from(r.origin), Vec3A::from(r.dir), r.t_min, r.t_max)
+            })
+            .collect()
     }
     fn build(scene: &mut Self::Scene) -> Self::Accel {
-        obvhs::bvh2::builder::build_bvh2_from_tris(
-            scene,
-            obvhs::BvhBuildParams::fast_build(),
-            &mut Default::default(),
-        )
+        T::build(scene)
     }
     #[inline]
     fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> Option<f32> {
         let mut hit = obvhs::ray::RayHit::none();
+        let ids = accel.primitive_indices();
         accel
-            .ray_traverse(*ray, &mut hit, |r, id| {
-                scene[accel.primitive_indices[id] as usize].intersect(r)
-            })
+            .traverse(*ray, &mut hit, |r, id| scene[ids[id] as usize].intersect(r))
             .then_some(hit.t)
     }
     #[inline]
     fn any(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> bool {
-        !accel.ray_traverse_miss(*ray, |r, id| {
-            scene[accel.primitive_indices[id] as usize].intersect(r)
-        })
-    }
-}
-
-/// obvhs's 8-wide compressed tree from `fast_build`, with its SIMD traversal.
-pub struct ObvhsCwbvh;
-
-impl Library for ObvhsCwbvh {
-    const NAME: &'static str = "obvhs-cwbvh";
-    const PARALLEL_BUILD: Option<&'static str> =
-        Some("the same call with obvhs's `parallel` feature on the all-thread rayon pool");
-    type Scene = Vec<obvhs::triangle::Triangle>;
-    type Ray = obvhs::ray::Ray;
-    type Accel = obvhs::cwbvh::CwBvh;
-
-    fn scene(tris: &[Triangle]) -> Self::Scene {
-        obvhs_scene(tris)
-    }
-    fn rays(rays: &[Ray]) -> Vec<Self::Ray> {
-        obvhs_rays(rays)
-    }
-    fn build(scene: &mut Self::Scene) -> Self::Accel {
-        obvhs::cwbvh::builder::build_cwbvh_from_tris(
-            scene,
-            obvhs::BvhBuildParams::fast_build(),
-            &mut Default::default(),
-        )
-    }
-    #[inline]
-    fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> Option<f32> {
-        let mut hit = obvhs::ray::RayHit::none();
-        accel
-            .ray_traverse(*ray, &mut hit, |r, id| {
-                scene[accel.primitive_indices[id] as usize].intersect(r)
-            })
-            .then_some(hit.t)
-    }
-    #[inline]
-    fn any(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> bool {
-        !accel.ray_traverse_miss(*ray, |r, id| {
-            scene[accel.primitive_indices[id] as usize].intersect(r)
-        })
+        let ids = accel.primitive_indices();
+        !accel.traverse_miss(*ray, |r, id| scene[ids[id] as usize].intersect(r))
     }
 }
 

@@ -447,10 +447,9 @@ impl LeafVisitor for ClosestHitEdges {
     #[inline(always)]
     fn leaf(&mut self, blocks: &[Triangle4], _count: u32) -> bool {
         for block in blocks {
-            if let Some(j) = self.closest.take(block) {
-                if let Some(hit) = self.closest.best {
-                    self.best = Some((hit, block.edges(j)));
-                }
+            // `take` returns a lane only when it set `best`.
+            if let (Some(j), Some(hit)) = (self.closest.take(block), self.closest.best) {
+                self.best = Some((hit, block.edges(j)));
             }
         }
         false

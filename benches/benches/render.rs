@@ -3,13 +3,16 @@
 //! bounces, seed 1):
 //!
 //! - `render/SCENE/shadow/{global,lights,thesis}`: the frame's shadow segments answered on one
-//!   thread, as `shadow_ms` replays them (throughput in segments);
+//!   thread, as `shadow_ms` replays them: in the frame's batches, each in the structure's order
+//!   (throughput in segments);
 //! - `render/SCENE/in_frame/{closest_alone,global,lights,thesis}`: the same shadow segments
 //!   with the frame's camera and bounce rays (closest hit, through the structure's global BVH)
-//!   interleaved between them in their frame order and ratio, on one thread; `closest_alone`
-//!   traces those closest-hit rays alone. A structure's time minus `closest_alone` is what its shadow
+//!   in their frame order and ratio, on one thread, as the renderer traces them: a structure
+//!   that answers in batches takes each batch's closest-hit rays and then its shadow segments,
+//!   the others each segment between its share of closest-hit rays; `closest_alone` traces
+//!   those closest-hit rays alone. A structure's time minus `closest_alone` is what its shadow
 //!   segments cost inside a frame, where the global BVH's nodes and triangles share the caches
-//!   with theirs (a light buffer is a second copy of the scene the global BVH does not warm);
+//!   with theirs (a light buffer's trees are memory the global BVH does not warm);
 //! - `render/SCENE/build/{global,lights,thesis}`: building the structure, the `lights` pilot
 //!   frame included (two threads).
 //!
@@ -24,8 +27,9 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use glam::Vec3;
 use rdbvh::render::{
-    build_lights, emissive_lights, parse_lights, pilot_size, render_frame, Camera, FrameSettings,
-    Integrator, LightSet, ShadowRay, Structure, StructureKind, DEFAULT_FOV_DEG,
+    answer_batches, build_lights, emissive_lights, parse_lights, pilot_size, render_frame,
+    BatchOrder, Camera, FrameSettings, Integrator, LightSet, ShadowRay, Structure, StructureKind,
+    DEFAULT_FOV_DEG,
 };
 use rdbvh::scene::Scene;
 use rdbvh_benches::scenes_dir;
@@ -125,12 +129,12 @@ impl Loaded {
         built.expect("the structure builds")
     }
 
-    /// The frame's shadow segments and its camera and bounce rays (merged in frame order, in
-    /// their ratio), rendered through the global BVH.
-    fn frame_rays(&self) -> (Vec<ShadowRay>, Vec<Ray>) {
-        let global = self.build(StructureKind::Global);
+    /// The frame's shadow segments, the sizes of the batches `lights` answers them in, and its
+    /// camera and bounce rays (merged in frame order, in their ratio): the rays are every
+    /// structure's, the batches those of `structure`.
+    fn frame_rays(&self, structure: &Structure) -> (Vec<ShadowRay>, Vec<usize>, Vec<Ray>) {
         let integrator =
-            Integrator::new(&self.scene, &self.lights, &global, BOUNCES).expect("an integrator");
+            Integrator::new(&self.scene, &self.lights, structure, BOUNCES).expect("an integrator");
         let settings = FrameSettings {
             width: SIZE.0,
             height: SIZE.1,
@@ -155,7 +159,7 @@ impl Loaded {
                 b += 1;
             }
         }
-        (frame.shadow_rays, closest)
+        (frame.shadow_rays, frame.shadow_batches, closest)
     }
 }
 
@@ -168,13 +172,13 @@ fn render(c: &mut Criterion) {
                 continue;
             }
         };
-        let (shadow, closest) = loaded.frame_rays();
         let kinds = [
             StructureKind::Global,
             StructureKind::Lights,
             StructureKind::Thesis,
         ];
         let structures: Vec<Structure> = kinds.iter().map(|&k| loaded.build(k)).collect();
+        let (shadow, batches, closest) = loaded.frame_rays(&structures[1]);
         let mut group = c.benchmark_group(format!("render/{}/shadow", case.name));
         group
             .throughput(Throughput::Elements(shadow.len() as u64))
@@ -202,16 +206,18 @@ fn render(c: &mut Criterion) {
                 f64::from(stats.triangles) / n
             );
             group.bench_function(kind.name(), |b| {
-                b.iter(|| {
-                    black_box(&shadow)
-                        .iter()
-                        .filter(|s| structure.occluded(s.light as usize, &s.ray))
-                        .count()
-                })
+                b.iter(|| replay(structure, black_box(&shadow), &batches))
             });
         }
         group.finish();
-        in_frame(c, case.name, &kinds, &structures, &shadow, &closest);
+        in_frame(
+            c,
+            case.name,
+            &kinds,
+            &structures,
+            (&shadow, &batches),
+            &closest,
+        );
         let mut group = c.benchmark_group(format!("render/{}/build", case.name));
         group
             .sample_size(10)
@@ -226,14 +232,29 @@ fn render(c: &mut Criterion) {
     }
 }
 
-/// The `in_frame` group: each shadow segment followed by its share of the frame's closest-hit
-/// rays, against those closest-hit rays alone.
+/// The frame's shadow segments through `structure` in the frame's batches, as `shadow_ms`
+/// replays them. Returns how many are blocked.
+fn replay(structure: &Structure, shadow: &[ShadowRay], batches: &[usize]) -> usize {
+    let mut answers = vec![false; shadow.len()];
+    answer_batches(
+        structure,
+        shadow,
+        batches,
+        &mut answers,
+        &mut BatchOrder::default(),
+    );
+    answers.iter().filter(|&&a| a).count()
+}
+
+/// The `in_frame` group: the shadow segments with their share of the frame's closest-hit rays
+/// (each batch's rays then its segments, or each segment after its share), against those
+/// closest-hit rays alone.
 fn in_frame(
     c: &mut Criterion,
     name: &str,
     kinds: &[StructureKind],
     structures: &[Structure],
-    shadow: &[ShadowRay],
+    (shadow, batches): (&[ShadowRay], &[usize]),
     closest: &[Ray],
 ) {
     let mut group = c.benchmark_group(format!("render/{name}/in_frame"));
@@ -252,14 +273,31 @@ fn in_frame(
         })
     });
     let (n, m) = (shadow.len().max(1), closest.len());
+    let closest_hits = |s: &Structure, from: usize, to: usize| {
+        closest[from * m / n..to * m / n]
+            .iter()
+            .filter(|r| s.closest_hit(r).is_some())
+            .count()
+    };
     for (kind, structure) in kinds.iter().zip(structures) {
         group.bench_function(kind.name(), |b| {
             b.iter(|| {
                 let mut hits = 0;
-                for (i, s) in black_box(shadow).iter().enumerate() {
-                    hits += usize::from(structure.occluded(s.light as usize, &s.ray));
-                    for r in &closest[i * m / n..(i + 1) * m / n] {
-                        hits += usize::from(structure.closest_hit(r).is_some());
+                if structure.answers_in_batches() {
+                    let (mut answers, mut order) = (vec![false; n], BatchOrder::default());
+                    let mut first = 0;
+                    for &size in batches {
+                        let end = (first + size).min(shadow.len());
+                        hits += closest_hits(structure, first, end);
+                        let (segments, answered) = (&shadow[first..end], &mut answers[first..end]);
+                        structure.occluded_batch(black_box(segments), answered, &mut order);
+                        hits += answered.iter().filter(|&&a| a).count();
+                        first = end;
+                    }
+                } else {
+                    for (i, s) in black_box(shadow).iter().enumerate() {
+                        hits += usize::from(structure.occluded(s.light as usize, &s.ray));
+                        hits += closest_hits(structure, i, i + 1);
                     }
                 }
                 hits

@@ -68,5 +68,5 @@ pub use error::BuildError;
 pub use geometry::{Aabb, Ray, Triangle};
 pub use glam::Vec3;
 pub use influence::{InfluenceArea, PlaneArea, PointArea};
-pub use prefetch::prefetch;
+pub use prefetch::{prefetch, prefetch_all};
 pub use toplevel::{TopLevel, TopLevelOptions};

@@ -116,6 +116,48 @@ fn images_depend_on_the_seed_alone_whatever_the_threads_and_structure() {
     assert!(lights["shadow_triangle_tests"].as_u64() < one["shadow_triangle_tests"].as_u64());
 }
 
+/// `lights` answers its shadow segments in batches of several tiles (as many as make a batch,
+/// at most a quarter of a thread's share of the tiles): the batches differ with the threads, and
+/// the image and the counts do not.
+#[test]
+fn batches_of_tiles_change_neither_the_image_nor_the_counts() {
+    let dir = scratch("batches");
+    let lights_file = dir.join("point.toml");
+    std::fs::write(
+        &lights_file,
+        "[[light]]\nkind = \"point\"\nposition = [5.0, 4.5, 5.0]\nintensity = [20.0, 20.0, 20.0]\n",
+    )
+    .unwrap();
+    // 6 x 4 tiles: batches of 6 tiles on one thread, of 3 on two.
+    let mut scene = ROOM[..7].to_vec();
+    scene.extend(["--width", "96", "--height", "64", "--spp", "2"]);
+    scene.extend(["--lights", lights_file.to_str().unwrap()]);
+    let global = render(&scene, &dir.join("g.png"), &["--threads", "1"]);
+    let one = render(
+        &scene,
+        &dir.join("l1.png"),
+        &["--structure", "lights", "--threads", "1"],
+    );
+    let two = render(
+        &scene,
+        &dir.join("l2.png"),
+        &["--structure", "lights", "--threads", "2"],
+    );
+    assert!(one["light_buffers"].as_u64().unwrap() >= 1);
+    let png = |n: &str| std::fs::read(dir.join(n)).unwrap();
+    assert_eq!(png("g.png"), png("l1.png"));
+    assert_eq!(png("g.png"), png("l2.png"));
+    for key in [
+        "shadow_rays",
+        "shadow_occluded",
+        "shadow_node_tests",
+        "shadow_triangle_tests",
+    ] {
+        assert_eq!(one[key], two[key], "{key}");
+    }
+    assert_eq!(global["shadow_occluded"], one["shadow_occluded"]);
+}
+
 #[test]
 fn json_has_the_contract_keys() {
     let dir = scratch("json");

@@ -168,17 +168,66 @@ impl LightBuffer {
         self.query(scene, ray, stats)
     }
 
-    /// The query, counting into `stats` or (with `()`) not at all.
-    #[inline(always)]
-    fn query(&self, scene: &WideBvh8, ray: &Ray, stats: &mut impl Counters) -> Option<bool> {
+    /// The finest grid cell that answers the shadow segment `ray` (an index below
+    /// [`LightBuffer::cells`]), or `None` for a segment that is not the buffer's to answer (see
+    /// [`LightBuffer::occluded_with_stats`]). A renderer that answers many segments at once can
+    /// take them cell by cell ([`LightBuffer::occluded_in_cell`]): segments of one cell walk one
+    /// small tree, which then stays in the caches.
+    #[inline]
+    pub fn cell_of(&self, scene: &WideBvh8, ray: &Ray) -> Option<u32> {
         if (scene.nodes.len(), scene.tris.len()) != self.scene_size
             || !self.source.ends_on_light(ray, self.end_box, self.margin)
         {
             return None;
         }
-        let cell = self.cell(-ray.dir);
+        Some(self.cell(-ray.dir) as u32)
+    }
+
+    /// Cells in the finest grid: `6 * resolution^2`.
+    pub fn cells(&self) -> usize {
+        self.grid.len()
+    }
+
+    /// [`LightBuffer::occluded_with_stats`] for a segment whose cell [`LightBuffer::cell_of`]
+    /// gave, without counting. Given another cell the answer is that cell's tree's, which need
+    /// not be the segment's.
+    #[inline]
+    pub fn occluded_in_cell(&self, cell: u32, scene: &WideBvh8, ray: &Ray) -> Option<bool> {
+        self.answer(cell, scene, ray, &mut ())
+    }
+
+    /// [`LightBuffer::occluded_with_stats`] for a segment whose cell [`LightBuffer::cell_of`]
+    /// gave: the same answer and the same counts.
+    #[inline]
+    pub fn occluded_in_cell_with_stats(
+        &self,
+        cell: u32,
+        scene: &WideBvh8,
+        ray: &Ray,
+        stats: &mut TraversalStats,
+    ) -> Option<bool> {
+        self.answer(cell, scene, ray, stats)
+    }
+
+    /// The query, counting into `stats` or (with `()`) not at all.
+    #[inline(always)]
+    fn query(&self, scene: &WideBvh8, ray: &Ray, stats: &mut impl Counters) -> Option<bool> {
+        let cell = self.cell_of(scene, ray)?;
+        self.answer(cell, scene, ray, stats)
+    }
+
+    /// Cell `cell`'s answer for `ray`: the lookup counts as one inner node. A cell out of range
+    /// answers `None`, as a segment that is not the buffer's.
+    #[inline(always)]
+    fn answer(
+        &self,
+        cell: u32,
+        scene: &WideBvh8,
+        ray: &Ray,
+        stats: &mut impl Counters,
+    ) -> Option<bool> {
         stats.node();
-        match self.grid[cell] {
+        match *self.grid.get(cell as usize)? {
             DARK => None,
             CLEAR => Some(false),
             root => Some(self.forest.any_hit_from(root, &scene.tris, ray, stats)),

@@ -7,7 +7,7 @@ use glam::Vec3;
 
 use super::{LightBuffer, LightBufferOptions, LightSource};
 use crate::brute_force;
-use crate::bvh::WideBvh8;
+use crate::bvh::{TraversalStats, WideBvh8};
 use crate::geometry::{Ray, Triangle};
 use crate::random::Pcg32;
 use crate::{BuildError, BuildOptions, Preset};
@@ -66,10 +66,20 @@ fn shadow(p: Vec3, s: Vec3) -> Ray {
     Ray::segment(p, s - p, 0.0, 1.0 - 1e-4).unwrap()
 }
 
-/// Checks `rays` through `buffer` against brute force; returns how many it answered.
+/// Checks `rays` through `buffer` against brute force, and the cell by cell query against the
+/// whole one (answers and counts); returns how many it answered.
 fn check(buffer: &Built, tris: &[Triangle], rays: &[Ray]) -> usize {
+    let (b, scene) = (&buffer.buffer, &buffer.scene);
     let mut answered = 0;
     for (i, ray) in rays.iter().enumerate() {
+        let mut whole = TraversalStats::default();
+        let answer = b.occluded_with_stats(scene, ray, &mut whole);
+        let cell = b.cell_of(scene, ray);
+        assert!(cell.is_none_or(|c| (c as usize) < b.cells()), "ray {i}");
+        let mut by_cell = TraversalStats::default();
+        let via = cell.and_then(|c| b.occluded_in_cell_with_stats(c, scene, ray, &mut by_cell));
+        assert_eq!((via, by_cell), (answer, whole), "ray {i}: {ray:?}");
+        assert_eq!(cell.and_then(|c| b.occluded_in_cell(c, scene, ray)), answer);
         if let Some(hit) = buffer.occluded(ray) {
             assert_eq!(hit, brute_force::any_hit(ray, tris), "ray {i}: {ray:?}");
             answered += 1;

@@ -132,7 +132,10 @@ pub fn render() -> String {
          pilot segments' median length gets no buffer built, and a buffer built is kept\n\
          only where those segments need at most 0.7 of the global BVH's node + triangle tests\n\
          through it; build_ms includes the pilot (global_build_ms is the global BVH's part,\n\
-         pilot_ms the pilot frame's).\n\
+         pilot_ms the pilot frame's). With a buffer kept, paths are traced in batches of\n\
+         consecutive tiles (about 32768 samples), and each batch's shadow segments are answered\n\
+         together, cell by cell of the buffers, so that a cell's tree stays in the caches; the\n\
+         radiance is then summed in each path's order, bit for bit as if answered one by one.\n\
          thesis, the thesis's own structure with influence areas made from the lights: six\n\
          90-degree frustums around a point light (one per cube face, apex at the light, to the\n\
          scene's far end), one frustum along a spot of at most 120 degrees (six for a wider one),\n\
@@ -145,7 +148,7 @@ pub fn render() -> String {
          as the global BVH does: the images are byte-identical.\n\
          shadow_ms is the best of --shadow-replays single-thread replays of the frame's shadow\n\
          segments (its first 2097152 when it has more) through the structure alone, without\n\
-         counters; the replay's answers must equal the frame's.\n\
+         counters, in the frame's batches; the replay's answers must equal the frame's.\n\
          --json prints one object as the last line, with the keys scene, triangles, lights,\n\
          light_buffers, light_buffers_dropped, light_buffers_skipped, pilot_shadow_rays,\n\
          influence_areas, influence_area_triangles, width, height, spp, max_bounces, seed,\n\

@@ -252,7 +252,12 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         progress: std::io::stderr().is_terminal(),
     };
     let frame = render_frame(&integrator, &camera, &settings);
-    let shadow_ms = replay_shadow_rays(&structure, &frame.shadow_rays, args.shadow_replays)?;
+    let shadow_ms = replay_shadow_rays(
+        &structure,
+        &frame.shadow_rays,
+        &frame.shadow_batches,
+        args.shadow_replays,
+    )?;
 
     let png = encode_png(&to_srgb8(&frame.pixels), args.width, args.height)?;
     fs::write(&args.out, png).map_err(|source| CliError::Write {

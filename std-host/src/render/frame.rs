@@ -1,11 +1,15 @@
 //! One frame: tiles on rayon's threads, the frame's counters, the shadow rays kept for the
 //! replay, and the recorded rays.
 //!
-//! Tiles are 16 x 16 pixels in row-major order. They run in groups of a few per thread, and each
-//! group's output is appended in tile order, so everything a frame keeps (the shadow rays for the
-//! replay, the recorded rays) is the same for a seed whatever the thread count: the first rays in
-//! tile order, then pixel order within the tile (row-major), then sample, then path vertex.
+//! Tiles are 16 x 16 pixels in row-major order. A batch of consecutive tiles is one task: its
+//! paths are traced, then their shadow segments answered together ([`PathBatch`]), then their
+//! radiance summed. Batches run in groups of a few per thread, and each group's output is
+//! appended in tile order, so everything a frame keeps (the shadow rays for the replay, the
+//! recorded rays) is the same for a seed whatever the thread count: the first rays in tile
+//! order, then pixel order within the tile (row-major), then sample, then path vertex.
 
+use std::cell::RefCell;
+use std::ops::Range;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -16,6 +20,7 @@ use rdbvh_core::Vec3;
 
 use super::integrator::{Integrator, PathObserver, ShadowRay};
 use super::sampler::{Sampler, DIM_PIXEL_X, DIM_PIXEL_Y};
+use super::shadow_batch::PathBatch;
 use super::Camera;
 
 /// Tile side in pixels.
@@ -25,9 +30,21 @@ pub const TILE: u32 = 16;
 /// with more replays its first ones.
 pub const REPLAY_CAP: usize = 1 << 21;
 
-/// Tiles per thread in one group: enough to balance the threads, few enough that a group's
-/// kept rays stay small.
-const TILES_PER_THREAD: usize = 4;
+/// Samples a batch of tiles holds, at least: enough shadow segments (a few per sample) that
+/// those of one light buffer cell come in runs, few enough that a batch's paths stay in memory
+/// (a few MB).
+pub const BATCH_SAMPLES: usize = 1 << 15;
+
+/// Batches per thread in one group: enough to balance the threads, few enough that a group's
+/// kept rays stay small. A frame has at least this many batches per thread where it has the
+/// tiles, however few samples they hold.
+const BATCHES_PER_THREAD: usize = 4;
+
+thread_local! {
+    /// Each thread's batch of paths, kept from frame to frame: a batch holds a few MB, which
+    /// allocated afresh for each batch cost page faults and copies as it grew.
+    static PATHS: RefCell<PathBatch> = RefCell::new(PathBatch::default());
+}
 
 /// What to render.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -94,15 +111,18 @@ pub struct Frame {
     pub counters: FrameCounters,
     /// The first [`REPLAY_CAP`] shadow segments, for the replay.
     pub shadow_rays: Vec<ShadowRay>,
+    /// How many of `shadow_rays` each batch made, in order: the replay answers them in the
+    /// same batches.
+    pub shadow_batches: Vec<usize>,
     /// The recorded rays (empty without a record limit).
     pub recorded: RecordedRays,
     /// Wall-clock milliseconds of the frame.
     pub render_ms: f64,
 }
 
-/// What one tile gives back.
-struct TileOutput {
-    /// The tile's first pixel index and its pixels' radiance, row by row.
+/// What one batch of tiles gives back.
+struct BatchOutput {
+    /// Each pixel's index and radiance, tile by tile, row by row.
     pixels: Vec<(usize, Vec3)>,
     observer: Observer,
 }
@@ -167,30 +187,44 @@ pub fn render_frame(integrator: &Integrator, camera: &Camera, settings: &FrameSe
         pixels: vec![Vec3::ZERO; (w as usize) * (h as usize)],
         counters: FrameCounters::default(),
         shadow_rays: Vec::new(),
+        shadow_batches: Vec::new(),
         recorded: RecordedRays::default(),
         render_ms: 0.0,
     };
-    let group = rayon::current_num_threads().max(1) * TILES_PER_THREAD;
-    for first in (0..tiles).step_by(group) {
+    let threads = rayon::current_num_threads().max(1);
+    let samples_per_tile = (TILE * TILE) as usize * settings.spp.max(1) as usize;
+    // A structure that answers each shadow segment where it is made needs no batch but a tile.
+    let per_batch = match integrator.batched() {
+        true => BATCH_SAMPLES.div_ceil(samples_per_tile),
+        false => 1,
+    }
+    .min(tiles / (threads * BATCHES_PER_THREAD))
+    .max(1);
+    let batches = tiles.div_ceil(per_batch);
+    let group = threads * BATCHES_PER_THREAD;
+    for first in (0..batches).step_by(group) {
         let room = |kept: usize, cap: usize| cap.saturating_sub(kept);
         let shadow_room = room(frame.shadow_rays.len(), REPLAY_CAP);
         let r = &frame.recorded;
         let record_room = [r.camera.len(), r.bounce.len(), r.shadow.len()]
             .map(|kept| room(kept, settings.record_limit));
-        let outputs: Vec<TileOutput> = (first..tiles.min(first + group))
+        let outputs: Vec<BatchOutput> = (first..batches.min(first + group))
             .into_par_iter()
-            .map(|tile| {
-                let (tx, ty) = (tile as u32 % tiles_x, tile as u32 / tiles_x);
-                let out = render_tile(
-                    integrator,
-                    camera,
-                    settings,
-                    tx,
-                    ty,
-                    shadow_room,
-                    record_room,
-                );
-                progress.inc(1);
+            .map(|b| {
+                let tiles = b * per_batch..tiles.min((b + 1) * per_batch);
+                let n = tiles.len() as u64;
+                let out = PATHS.with_borrow_mut(|paths| {
+                    render_tiles(
+                        integrator,
+                        camera,
+                        settings,
+                        (tiles, tiles_x),
+                        paths,
+                        shadow_room,
+                        record_room,
+                    )
+                });
+                progress.inc(n);
                 out
             })
             .collect();
@@ -200,7 +234,11 @@ pub fn render_frame(integrator: &Integrator, camera: &Camera, settings: &FrameSe
             }
             let o = out.observer;
             frame.counters.add(&o.counters);
+            let kept = frame.shadow_rays.len();
             keep(&mut frame.shadow_rays, o.shadow, REPLAY_CAP);
+            if frame.shadow_rays.len() > kept {
+                frame.shadow_batches.push(frame.shadow_rays.len() - kept);
+            }
             let limit = settings.record_limit;
             keep(&mut frame.recorded.camera, o.recorded.camera, limit);
             keep(&mut frame.recorded.bounce, o.recorded.bounce, limit);
@@ -218,17 +256,17 @@ fn keep<T>(kept: &mut Vec<T>, more: Vec<T>, cap: usize) {
     kept.extend(more.into_iter().take(room));
 }
 
-/// Renders tile `(tx, ty)`, keeping up to `shadow_room` shadow rays and `record_room` rays of
-/// each kind.
-fn render_tile(
+/// Renders the tiles `tiles` of a frame `tiles_x` tiles wide as one batch of paths in `paths`,
+/// keeping up to `shadow_room` shadow rays and `record_room` rays of each kind.
+fn render_tiles(
     integrator: &Integrator,
     camera: &Camera,
     s: &FrameSettings,
-    tx: u32,
-    ty: u32,
+    (tiles, tiles_x): (Range<usize>, u32),
+    paths: &mut PathBatch,
     shadow_room: usize,
     record_room: [usize; 3],
-) -> TileOutput {
+) -> BatchOutput {
     let mut observer = Observer {
         counters: FrameCounters::default(),
         shadow: Vec::new(),
@@ -236,21 +274,37 @@ fn render_tile(
         recorded: RecordedRays::default(),
         record_room,
     };
-    let mut pixels = Vec::with_capacity((TILE * TILE) as usize);
-    for y in ty * TILE..((ty + 1) * TILE).min(s.height) {
-        for x in tx * TILE..((tx + 1) * TILE).min(s.width) {
-            let pixel = u64::from(y) * u64::from(s.width) + u64::from(x);
-            let mut sum = Vec3::ZERO;
-            for sample in 0..s.spp {
-                let sampler = Sampler::new(s.seed, pixel, sample);
-                let ray = camera.ray(
-                    x as f32 + sampler.get(DIM_PIXEL_X),
-                    y as f32 + sampler.get(DIM_PIXEL_Y),
-                );
-                sum += integrator.radiance(ray, &sampler, &mut observer);
+    paths.clear();
+    let mut pixels = Vec::with_capacity(tiles.len() * (TILE * TILE) as usize);
+    for tile in tiles {
+        let (tx, ty) = (tile as u32 % tiles_x, tile as u32 / tiles_x);
+        for y in ty * TILE..((ty + 1) * TILE).min(s.height) {
+            for x in tx * TILE..((tx + 1) * TILE).min(s.width) {
+                let pixel = u64::from(y) * u64::from(s.width) + u64::from(x);
+                for sample in 0..s.spp {
+                    let sampler = Sampler::new(s.seed, pixel, sample);
+                    let ray = camera.ray(
+                        x as f32 + sampler.get(DIM_PIXEL_X),
+                        y as f32 + sampler.get(DIM_PIXEL_Y),
+                    );
+                    integrator.trace(ray, &sampler, &mut observer, paths);
+                }
+                pixels.push((pixel as usize, Vec3::ZERO));
             }
-            pixels.push((pixel as usize, sum / s.spp as f32));
         }
     }
-    TileOutput { pixels, observer }
+    integrator.answer(paths);
+    for (shadow, stats) in paths.segments.iter().zip(&paths.stats) {
+        observer.shadow(shadow, stats);
+    }
+    // Each pixel's samples, summed in order as the paths were traced.
+    let mut radiance = paths.radiance();
+    for (_, p) in &mut pixels {
+        let mut sum = Vec3::ZERO;
+        for r in radiance.by_ref().take(s.spp as usize) {
+            sum += r;
+        }
+        *p = sum / s.spp as f32;
+    }
+    BatchOutput { pixels, observer }
 }

@@ -12,6 +12,7 @@ use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::{prefetch, Vec3};
 
 use super::sampler::{vertex_dim, Sampler};
+use super::shadow_batch::PathBatch;
 use super::{LightSet, RenderError, Structure};
 use crate::scene::{Scene, DEFAULT_DIFFUSE};
 
@@ -56,6 +57,8 @@ pub struct Integrator<'a> {
     structure: &'a Structure,
     max_bounces: u32,
     offset: f32,
+    /// Whether the structure answers shadow segments fastest in batches.
+    batched: bool,
 }
 
 impl<'a> Integrator<'a> {
@@ -97,18 +100,53 @@ impl<'a> Integrator<'a> {
             structure,
             max_bounces,
             offset: (OFFSET_SCALE * scale).max(f32::MIN_POSITIVE),
+            batched: structure.answers_in_batches(),
         })
     }
 
     /// The radiance a path started by `camera_ray` carries back, drawing its numbers from
-    /// `sampler`; its rays go to `observer`.
+    /// `sampler`; its rays go to `observer`. One path alone: a frame traces paths in batches
+    /// ([`Integrator::trace`]), with the same result bit for bit.
     pub fn radiance(
         &self,
         camera_ray: Ray,
         sampler: &Sampler,
         observer: &mut impl PathObserver,
     ) -> Vec3 {
-        let mut radiance = Vec3::ZERO;
+        let mut batch = PathBatch::default();
+        self.trace(camera_ray, sampler, observer, &mut batch);
+        self.answer(&mut batch);
+        for (s, stats) in batch.segments.iter().zip(&batch.stats) {
+            observer.shadow(s, stats);
+        }
+        let radiance = batch.radiance().next().unwrap_or(Vec3::ZERO);
+        radiance
+    }
+
+    /// Whether [`Integrator::trace`] keeps the shadow segments for [`Integrator::answer`] (the
+    /// structure answers them fastest in batches) rather than answering each where it is made.
+    pub fn batched(&self) -> bool {
+        self.batched
+    }
+
+    /// Answers the shadow segments of `batch` through the structure.
+    pub fn answer(&self, batch: &mut PathBatch) {
+        batch.answer(self.structure);
+    }
+
+    /// Traces the path started by `camera_ray` into `batch`, drawing its numbers from
+    /// `sampler`: its camera and bounce rays now (they go to `observer`), and what each vertex
+    /// adds to the radiance kept for [`PathBatch::radiance`]. Its shadow segments are answered
+    /// now (and go to `observer`) where the structure answers fastest so, else kept for
+    /// [`Integrator::answer`] (whose caller gives them to the observer). The path's course does
+    /// not depend on its shadow segments' answers, only its radiance does.
+    pub fn trace(
+        &self,
+        camera_ray: Ray,
+        sampler: &Sampler,
+        observer: &mut impl PathObserver,
+        batch: &mut PathBatch,
+    ) {
         let mut throughput = Vec3::ONE;
         let mut ray = camera_ray;
         for depth in 0..=self.max_bounces {
@@ -116,9 +154,8 @@ impl<'a> Integrator<'a> {
             observer.closest(depth, &ray, found.as_ref().map(|(hit, _)| hit));
             let Some((hit, t)) = found else { break };
             let id = hit.triangle as usize;
-            // The material's entries are read after the shadow segment (in the same order of
-            // additions): fetched now, they arrive while it is traced, where read here they
-            // were the costliest load of the shading.
+            // The material's entries are read after the light sample: fetched now, they
+            // arrive meanwhile, where read here they were the costliest load of the shading.
             prefetch(&self.albedo[id]);
             if depth == 0 {
                 prefetch(&self.emission[id]);
@@ -146,33 +183,37 @@ impl<'a> Integrator<'a> {
                 sampler.get(dim + 1),
                 sampler.get(dim + 2),
             );
-            // The light sample's weight and geometric factor, when its segment is unoccluded.
+            // The light sample's segment, weight and geometric factor.
             let mut lit = None;
             if let Some(s) = sample {
                 let d = s.target - origin;
                 let cos = n.dot(d);
                 if cos > 0.0 {
                     if let Ok(segment) = Ray::segment(origin, d, 0.0, 1.0 - SHADOW_END) {
-                        let mut stats = TraversalStats::default();
-                        let occluded = self.structure.occluded_counted(light, &segment, &mut stats);
-                        let shadow = ShadowRay {
-                            light: light as u32,
-                            ray: segment,
-                            occluded,
+                        let gate = if self.batched {
+                            batch.defer(light, segment)
+                        } else {
+                            let mut stats = TraversalStats::default();
+                            let occluded =
+                                self.structure.occluded_counted(light, &segment, &mut stats);
+                            let shadow = ShadowRay {
+                                light: light as u32,
+                                ray: segment,
+                                occluded,
+                            };
+                            observer.shadow(&shadow, &stats);
+                            batch.answered(occluded)
                         };
-                        observer.shadow(&shadow, &stats);
-                        if !occluded {
-                            lit = Some((s.weight, FRAC_1_PI * cos / (d.length() * probability)));
-                        }
+                        lit = Some((gate, s.weight, FRAC_1_PI * cos / (d.length() * probability)));
                     }
                 }
             }
             if depth == 0 {
-                radiance += throughput * self.emission[id];
+                batch.term(throughput * self.emission[id], None);
             }
             let albedo = self.albedo[id];
-            if let Some((weight, geometry)) = lit {
-                radiance += throughput * albedo * weight * geometry;
+            if let Some((gate, weight, geometry)) = lit {
+                batch.term(throughput * albedo * weight * geometry, Some(gate));
             }
 
             if depth == self.max_bounces {
@@ -193,7 +234,7 @@ impl<'a> Integrator<'a> {
                 Err(_) => break,
             }
         }
-        radiance
+        batch.end_path();
     }
 }
 

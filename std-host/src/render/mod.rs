@@ -18,6 +18,11 @@
 //!   frame shows it pays, [`pilot`]; or `thesis`: the thesis's influence areas, octree and
 //!   fallback, [`ThesisStructure`]). All answer
 //!   exactly as the global BVH does, so their images are byte-identical.
+//! - **Batches.** Where the structure answers shadow segments fastest together (`lights` with a
+//!   buffer: cell by cell), a frame traces its paths in batches of tiles and answers each
+//!   batch's segments at once, then sums every path's radiance in its own order
+//!   ([`shadow_batch`]); the global BVH answers each segment where it is made, next to the hit
+//!   whose nodes are still in the caches.
 //! - **Measures.** The frame counts its rays and the shadow segments' node and triangle tests;
 //!   [`replay_shadow_rays`] times the frame's shadow segments on one thread.
 
@@ -32,6 +37,7 @@ pub mod lights_file;
 pub mod pilot;
 mod replay;
 pub mod sampler;
+pub mod shadow_batch;
 mod structure;
 mod thesis;
 
@@ -46,6 +52,7 @@ pub use light::{emissive_lights, luminance, Light, LightSample, LightSet};
 pub use light_structure::{CLUSTER_EXTENT, MAX_LIGHT_BUFFERS};
 pub use lights_file::{parse_lights, read_lights};
 pub use pilot::{build_lights, pilot_size, prune_by_pilot, PilotReport, KEEP_RATIO, PILOT_DIVISOR};
-pub use replay::replay_shadow_rays;
+pub use replay::{answer_batches, replay_shadow_rays};
+pub use shadow_batch::{BatchOrder, PathBatch};
 pub use structure::{Structure, StructureKind};
 pub use thesis::{ThesisStructure, ThesisSummary};

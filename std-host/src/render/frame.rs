@@ -14,13 +14,13 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use rdbvh_core::bvh::{Hit, TraversalStats};
+use rdbvh_core::bvh::Hit;
 use rdbvh_core::geometry::Ray;
 use rdbvh_core::Vec3;
 
 use super::integrator::{Integrator, PathObserver, ShadowRay};
 use super::sampler::{Sampler, DIM_PIXEL_X, DIM_PIXEL_Y};
-use super::shadow_batch::PathBatch;
+use super::shadow_batch::{PathBatch, ShadowTests};
 use super::Camera;
 
 /// Tile side in pixels.
@@ -154,18 +154,28 @@ impl PathObserver for Observer {
     }
 
     #[inline]
-    fn shadow(&mut self, shadow: &ShadowRay, stats: &TraversalStats) {
+    fn shadow(&mut self, shadow: &ShadowRay) {
+        self.shadows(std::slice::from_ref(shadow));
+    }
+
+    #[inline]
+    fn shadows(&mut self, shadows: &[ShadowRay]) {
         let c = &mut self.counters;
-        c.shadow_rays += 1;
-        c.shadow_occluded += u64::from(shadow.occluded);
-        c.shadow_node_tests += u64::from(stats.inner_nodes);
-        c.shadow_triangle_tests += u64::from(stats.triangles);
-        if self.shadow.len() < self.shadow_room {
-            self.shadow.push(*shadow);
+        c.shadow_rays += shadows.len() as u64;
+        c.shadow_occluded += shadows.iter().filter(|s| s.occluded).count() as u64;
+        for (kept, room) in [
+            (&mut self.shadow, self.shadow_room),
+            (&mut self.recorded.shadow, self.record_room[2]),
+        ] {
+            let n = room.saturating_sub(kept.len()).min(shadows.len());
+            kept.extend_from_slice(&shadows[..n]);
         }
-        if self.recorded.shadow.len() < self.record_room[2] {
-            self.recorded.shadow.push(*shadow);
-        }
+    }
+
+    #[inline]
+    fn shadow_tests(&mut self, tests: &ShadowTests) {
+        self.counters.shadow_node_tests += tests.nodes;
+        self.counters.shadow_triangle_tests += tests.triangles;
     }
 }
 
@@ -275,28 +285,36 @@ fn render_tiles(
         record_room,
     };
     paths.clear();
+    let batched = integrator.batched();
     let mut pixels = Vec::with_capacity(tiles.len() * (TILE * TILE) as usize);
     for tile in tiles {
         let (tx, ty) = (tile as u32 % tiles_x, tile as u32 / tiles_x);
         for y in ty * TILE..((ty + 1) * TILE).min(s.height) {
             for x in tx * TILE..((tx + 1) * TILE).min(s.width) {
                 let pixel = u64::from(y) * u64::from(s.width) + u64::from(x);
+                let mut sum = Vec3::ZERO;
                 for sample in 0..s.spp {
                     let sampler = Sampler::new(s.seed, pixel, sample);
                     let ray = camera.ray(
                         x as f32 + sampler.get(DIM_PIXEL_X),
                         y as f32 + sampler.get(DIM_PIXEL_Y),
                     );
-                    integrator.trace(ray, &sampler, &mut observer, paths);
+                    if batched {
+                        integrator.trace(ray, &sampler, &mut observer, paths);
+                    } else {
+                        sum += integrator.radiance(ray, &sampler, &mut observer);
+                    }
                 }
-                pixels.push((pixel as usize, Vec3::ZERO));
+                pixels.push((pixel as usize, sum / s.spp as f32));
             }
         }
     }
-    integrator.answer(paths);
-    for (shadow, stats) in paths.segments.iter().zip(&paths.stats) {
-        observer.shadow(shadow, stats);
+    if !batched {
+        return BatchOutput { pixels, observer };
     }
+    integrator.answer(paths);
+    observer.shadows(&paths.segments);
+    observer.shadow_tests(&paths.tests);
     // Each pixel's samples, summed in order as the paths were traced.
     let mut radiance = paths.radiance();
     for (_, p) in &mut pixels {

@@ -12,7 +12,7 @@ use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::{prefetch, Vec3};
 
 use super::sampler::{vertex_dim, Sampler};
-use super::shadow_batch::PathBatch;
+use super::shadow_batch::{PathBatch, ShadowTests};
 use super::{LightSet, RenderError, Structure};
 use crate::scene::{Scene, DEFAULT_DIFFUSE};
 
@@ -43,8 +43,17 @@ pub struct ShadowRay {
 pub trait PathObserver {
     /// A camera (`depth == 0`) or bounce ray and its closest hit.
     fn closest(&mut self, depth: u32, ray: &Ray, hit: Option<&Hit>);
-    /// A shadow segment, its answer, and the tests it cost.
-    fn shadow(&mut self, shadow: &ShadowRay, stats: &TraversalStats);
+    /// A shadow segment and its answer, in path order.
+    fn shadow(&mut self, shadow: &ShadowRay);
+    /// Shadow segments, in path order: [`PathObserver::shadow`] for each.
+    fn shadows(&mut self, shadows: &[ShadowRay]) {
+        for s in shadows {
+            self.shadow(s);
+        }
+    }
+    /// The node and triangle tests shadow segments cost: one segment's where it was answered
+    /// alone, a batch's sum where its segments were answered together.
+    fn shadow_tests(&mut self, tests: &ShadowTests);
 }
 
 /// Everything a path needs, shared by every thread.
@@ -105,26 +114,23 @@ impl<'a> Integrator<'a> {
     }
 
     /// The radiance a path started by `camera_ray` carries back, drawing its numbers from
-    /// `sampler`; its rays go to `observer`. One path alone: a frame traces paths in batches
-    /// ([`Integrator::trace`]), with the same result bit for bit.
+    /// `sampler`; its rays go to `observer`, each shadow segment answered where it is made.
     pub fn radiance(
         &self,
         camera_ray: Ray,
         sampler: &Sampler,
         observer: &mut impl PathObserver,
     ) -> Vec3 {
-        let mut batch = PathBatch::default();
-        self.trace(camera_ray, sampler, observer, &mut batch);
-        self.answer(&mut batch);
-        for (s, stats) in batch.segments.iter().zip(&batch.stats) {
-            observer.shadow(s, stats);
-        }
-        let radiance = batch.radiance().next().unwrap_or(Vec3::ZERO);
-        radiance
+        let mut now = AnswerNow {
+            radiance: Vec3::ZERO,
+        };
+        self.path(camera_ray, sampler, observer, &mut now);
+        now.radiance
     }
 
-    /// Whether [`Integrator::trace`] keeps the shadow segments for [`Integrator::answer`] (the
-    /// structure answers them fastest in batches) rather than answering each where it is made.
+    /// Whether a frame should trace its paths with [`Integrator::trace`] into batches and
+    /// answer them with [`Integrator::answer`] (the structure answers shadow segments fastest
+    /// so) rather than with [`Integrator::radiance`].
     pub fn batched(&self) -> bool {
         self.batched
     }
@@ -135,17 +141,30 @@ impl<'a> Integrator<'a> {
     }
 
     /// Traces the path started by `camera_ray` into `batch`, drawing its numbers from
-    /// `sampler`: its camera and bounce rays now (they go to `observer`), and what each vertex
-    /// adds to the radiance kept for [`PathBatch::radiance`]. Its shadow segments are answered
-    /// now (and go to `observer`) where the structure answers fastest so, else kept for
-    /// [`Integrator::answer`] (whose caller gives them to the observer). The path's course does
-    /// not depend on its shadow segments' answers, only its radiance does.
+    /// `sampler`: its camera and bounce rays now (they go to `observer`); its shadow segments,
+    /// and what each vertex adds to the radiance, kept for [`Integrator::answer`] and
+    /// [`PathBatch::radiance`], which give the radiance [`Integrator::radiance`] gives, bit for
+    /// bit. The path's course does not depend on its shadow segments' answers, only its
+    /// radiance does.
     pub fn trace(
         &self,
         camera_ray: Ray,
         sampler: &Sampler,
         observer: &mut impl PathObserver,
         batch: &mut PathBatch,
+    ) {
+        self.path(camera_ray, sampler, observer, batch);
+        batch.end_path();
+    }
+
+    /// The path proper: its shadow segments and radiance terms go to `sink`, in order.
+    #[inline(always)]
+    fn path(
+        &self,
+        camera_ray: Ray,
+        sampler: &Sampler,
+        observer: &mut impl PathObserver,
+        sink: &mut impl PathSink,
     ) {
         let mut throughput = Vec3::ONE;
         let mut ray = camera_ray;
@@ -190,30 +209,17 @@ impl<'a> Integrator<'a> {
                 let cos = n.dot(d);
                 if cos > 0.0 {
                     if let Ok(segment) = Ray::segment(origin, d, 0.0, 1.0 - SHADOW_END) {
-                        let gate = if self.batched {
-                            batch.defer(light, segment)
-                        } else {
-                            let mut stats = TraversalStats::default();
-                            let occluded =
-                                self.structure.occluded_counted(light, &segment, &mut stats);
-                            let shadow = ShadowRay {
-                                light: light as u32,
-                                ray: segment,
-                                occluded,
-                            };
-                            observer.shadow(&shadow, &stats);
-                            batch.answered(occluded)
-                        };
+                        let gate = sink.segment(light, segment, self.structure, observer);
                         lit = Some((gate, s.weight, FRAC_1_PI * cos / (d.length() * probability)));
                     }
                 }
             }
             if depth == 0 {
-                batch.term(throughput * self.emission[id], None);
+                sink.term(throughput * self.emission[id], Gate::Open);
             }
             let albedo = self.albedo[id];
             if let Some((gate, weight, geometry)) = lit {
-                batch.term(throughput * albedo * weight * geometry, Some(gate));
+                sink.term(throughput * albedo * weight * geometry, gate);
             }
 
             if depth == self.max_bounces {
@@ -234,7 +240,69 @@ impl<'a> Integrator<'a> {
                 Err(_) => break,
             }
         }
-        batch.end_path();
+    }
+}
+
+/// What must hold for a vertex's radiance term to count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Gate {
+    /// Nothing: it always counts (a camera ray's emission).
+    Open,
+    /// A shadow segment answered already: it counts where the segment is clear.
+    Answered {
+        /// Whether the segment is blocked.
+        occluded: bool,
+    },
+    /// A shadow segment of a batch, by its index, answered later.
+    Pending(u32),
+}
+
+/// Where a path's shadow segments and radiance terms go: answered and summed now
+/// ([`Integrator::radiance`]), or kept in a batch ([`PathBatch`]).
+pub trait PathSink {
+    /// A shadow segment toward `light`, which `structure` answers now (telling `observer`) or
+    /// later; the gate of the term it decides.
+    fn segment(
+        &mut self,
+        light: usize,
+        ray: Ray,
+        structure: &Structure,
+        observer: &mut impl PathObserver,
+    ) -> Gate;
+    /// A radiance term, added in order, where `gate` lets it.
+    fn term(&mut self, value: Vec3, gate: Gate);
+}
+
+/// Each segment answered where it is made, the radiance summed as the path goes.
+struct AnswerNow {
+    radiance: Vec3,
+}
+
+impl PathSink for AnswerNow {
+    #[inline(always)]
+    fn segment(
+        &mut self,
+        light: usize,
+        ray: Ray,
+        structure: &Structure,
+        observer: &mut impl PathObserver,
+    ) -> Gate {
+        let mut stats = TraversalStats::default();
+        let occluded = structure.occluded_counted(light, &ray, &mut stats);
+        observer.shadow(&ShadowRay {
+            light: light as u32,
+            ray,
+            occluded,
+        });
+        observer.shadow_tests(&ShadowTests::of(&stats));
+        Gate::Answered { occluded }
+    }
+
+    #[inline(always)]
+    fn term(&mut self, value: Vec3, gate: Gate) {
+        if !matches!(gate, Gate::Answered { occluded: true }) {
+            self.radiance += value;
+        }
     }
 }
 
@@ -265,7 +333,8 @@ mod tests {
     struct Ignore;
     impl PathObserver for Ignore {
         fn closest(&mut self, _: u32, _: &Ray, _: Option<&Hit>) {}
-        fn shadow(&mut self, _: &ShadowRay, _: &TraversalStats) {}
+        fn shadow(&mut self, _: &ShadowRay) {}
+        fn shadow_tests(&mut self, _: &ShadowTests) {}
     }
 
     /// A 20 x 20 floor at y = 0 with albedo 0.5.

@@ -13,7 +13,34 @@ use rdbvh_core::bvh::TraversalStats;
 use rdbvh_core::geometry::Ray;
 use rdbvh_core::Vec3;
 
+use super::integrator::{Gate, PathObserver, PathSink};
 use super::{ShadowRay, Structure};
+
+/// Node and triangle tests summed over shadow segments.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ShadowTests {
+    /// Inner nodes visited (a light buffer's cell lookup counts as one).
+    pub nodes: u64,
+    /// Ray/triangle tests.
+    pub triangles: u64,
+}
+
+impl ShadowTests {
+    /// One query's tests.
+    pub fn of(stats: &TraversalStats) -> Self {
+        Self {
+            nodes: u64::from(stats.inner_nodes),
+            triangles: u64::from(stats.triangles),
+        }
+    }
+
+    /// Adds one query's tests.
+    #[inline]
+    pub fn add(&mut self, stats: &TraversalStats) {
+        self.nodes += u64::from(stats.inner_nodes);
+        self.triangles += u64::from(stats.triangles);
+    }
+}
 
 /// A term that no segment gates (a camera ray's emission).
 const UNGATED: u32 = u32::MAX;
@@ -30,8 +57,8 @@ pub struct BatchOrder {
     pub(super) bases: Vec<u32>,
     /// Per key, where its segments start in `order`.
     starts: Vec<u32>,
-    /// Segment indices in the order to answer them.
-    pub(super) order: Vec<u32>,
+    /// Segment indices in the order to answer them, each with its cell.
+    pub(super) order: Vec<(u32, u32)>,
 }
 
 /// A segment no light buffer cell answers.
@@ -39,7 +66,8 @@ pub(super) const NO_CELL: u32 = u32::MAX;
 
 impl BatchOrder {
     /// Groups the segments by key, keeping their order within a key (a counting sort over
-    /// `key_count` keys): `keys` must hold one key below `key_count` per segment.
+    /// `key_count` keys): `keys` must hold one key below `key_count` per segment, `cells` one
+    /// cell.
     pub(super) fn sort_by_keys(&mut self, key_count: usize) {
         self.starts.clear();
         self.starts.resize(key_count + 1, 0);
@@ -50,10 +78,10 @@ impl BatchOrder {
             self.starts[k] += self.starts[k - 1];
         }
         self.order.clear();
-        self.order.resize(self.keys.len(), 0);
-        for (i, &k) in self.keys.iter().enumerate() {
+        self.order.resize(self.keys.len(), (0, NO_CELL));
+        for (i, (&k, &cell)) in self.keys.iter().zip(&self.cells).enumerate() {
             let slot = &mut self.starts[k as usize];
-            self.order[*slot as usize] = i as u32;
+            self.order[*slot as usize] = (i as u32, cell);
             *slot += 1;
         }
     }
@@ -62,15 +90,13 @@ impl BatchOrder {
 /// A batch of paths whose shadow segments are not answered yet.
 #[derive(Clone, Debug, Default)]
 pub struct PathBatch {
-    /// The deferred segments, in the order the paths made them, each with its answer once
-    /// given.
+    /// The segments, in the order the paths made them, each with its answer once given.
     pub segments: Vec<ShadowRay>,
-    /// Each deferred segment's node and triangle tests, once answered.
-    pub stats: Vec<TraversalStats>,
-    /// The deferred segments answered so far: the first ones.
+    /// The segments' node and triangle tests, once answered.
+    pub tests: ShadowTests,
+    /// The segments answered so far: the first ones.
     answered: usize,
-    /// Every segment's answer, deferred or not, by its index: the radiance reads them, not the
-    /// segments.
+    /// Every segment's answer, by its index: the radiance reads them, not the segments.
     answers: Vec<bool>,
     /// What each vertex adds, in each path's order, and the segment that must be clear for it
     /// ([`UNGATED`] for none).
@@ -84,7 +110,7 @@ impl PathBatch {
     /// Empties the batch, keeping its memory.
     pub fn clear(&mut self) {
         self.segments.clear();
-        self.stats.clear();
+        self.tests = ShadowTests::default();
         self.answers.clear();
         self.answered = 0;
         self.terms.clear();
@@ -96,38 +122,14 @@ impl PathBatch {
         self.path_ends.len()
     }
 
-    /// Adds a shadow segment to the current path, to be answered with the batch
-    /// ([`PathBatch::answer`]); its index gates terms. A batch's segments are either all
-    /// deferred so or all answered where they are made ([`PathBatch::answered`]).
-    pub(super) fn defer(&mut self, light: usize, ray: Ray) -> u32 {
-        self.segments.push(ShadowRay {
-            light: light as u32,
-            ray,
-            occluded: false,
-        });
-        self.answers.push(false);
-        (self.answers.len() - 1) as u32
-    }
-
-    /// Adds the answer of a shadow segment answered where it was made; its index gates terms.
-    pub(super) fn answered(&mut self, occluded: bool) -> u32 {
-        self.answers.push(occluded);
-        (self.answers.len() - 1) as u32
-    }
-
-    /// Adds `value` to the current path's radiance, if `gate` (a segment index) is clear.
-    pub(super) fn term(&mut self, value: Vec3, gate: Option<u32>) {
-        self.terms.push((value, gate.unwrap_or(UNGATED)));
-    }
-
-    /// Ends the current path.
+    /// Ends the current path: the terms since the last end are its.
     pub(super) fn end_path(&mut self) {
         self.path_ends.push(self.terms.len() as u32);
     }
 
     /// Answers the deferred segments not answered yet through `structure`, together, in the
-    /// order it answers fastest ([`Structure::occluded_batch_counted`]), counting their tests
-    /// into `stats`.
+    /// order it answers fastest ([`Structure::occluded_batch_counted`]), adding their tests to
+    /// `tests`.
     pub fn answer(&mut self, structure: &Structure) {
         let (first, n) = (self.answered, self.segments.len());
         if first >= n {
@@ -138,11 +140,10 @@ impl PathBatch {
             self.answers.len(),
             "deferred and answered segments mixed"
         );
-        self.stats.resize(n, TraversalStats::default());
         structure.occluded_batch_counted(
             &self.segments[first..],
             &mut self.answers[first..],
-            &mut self.stats[first..],
+            &mut self.tests,
             &mut self.order,
         );
         for (s, &a) in self.segments[first..]
@@ -171,6 +172,36 @@ impl PathBatch {
     }
 }
 
+impl PathSink for PathBatch {
+    /// Keeps the segment for [`PathBatch::answer`].
+    #[inline(always)]
+    fn segment(
+        &mut self,
+        light: usize,
+        ray: Ray,
+        _: &Structure,
+        _: &mut impl PathObserver,
+    ) -> Gate {
+        self.segments.push(ShadowRay {
+            light: light as u32,
+            ray,
+            occluded: false,
+        });
+        self.answers.push(false);
+        Gate::Pending((self.answers.len() - 1) as u32)
+    }
+
+    #[inline(always)]
+    fn term(&mut self, value: Vec3, gate: Gate) {
+        let gate = match gate {
+            Gate::Open | Gate::Answered { occluded: false } => UNGATED,
+            Gate::Answered { occluded: true } => return,
+            Gate::Pending(segment) => segment,
+        };
+        self.terms.push((value, gate));
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -179,9 +210,12 @@ mod tests {
     fn keys_group_segments_in_order() {
         let mut order = BatchOrder::default();
         order.keys.extend([2, 0, 2, 1, 0, 3, 2]);
+        order.cells.extend([20, 0, 21, 10, 1, 30, 22]);
         order.sort_by_keys(4);
-        assert_eq!(order.order, [1, 4, 3, 0, 2, 6, 5]);
+        let expect = [(1, 0), (4, 1), (3, 10), (0, 20), (2, 21), (6, 22), (5, 30)];
+        assert_eq!(order.order, expect);
         order.keys.clear();
+        order.cells.clear();
         order.sort_by_keys(4);
         assert!(order.order.is_empty());
     }

@@ -16,7 +16,7 @@ use rdbvh_core::light_buffer::LightBuffer;
 use rdbvh_core::prefetch_all;
 
 use super::light_structure::light_buffers;
-use super::shadow_batch::{BatchOrder, NO_CELL};
+use super::shadow_batch::{BatchOrder, ShadowTests, NO_CELL};
 use super::thesis::ThesisStructure;
 use super::{Light, RenderError, ShadowRay};
 
@@ -255,18 +255,20 @@ impl Structure {
         });
     }
 
-    /// [`Structure::occluded_batch`], counting each segment's tests into its entry of `stats`
-    /// (as [`Structure::occluded_counted`] does: the order changes no count).
+    /// [`Structure::occluded_batch`], adding the segments' tests to `tests` (each counted as
+    /// [`Structure::occluded_counted`] counts it: the order changes no count).
     pub fn occluded_batch_counted(
         &self,
         segments: &[ShadowRay],
         answers: &mut [bool],
-        stats: &mut [TraversalStats],
+        tests: &mut ShadowTests,
         order: &mut BatchOrder,
     ) {
         self.for_each_in_order(segments, order, |i, cell| {
             let s = &segments[i];
-            answers[i] = self.occluded_in(s.light as usize, cell, &s.ray, &mut stats[i]);
+            let mut stats = TraversalStats::default();
+            answers[i] = self.occluded_in(s.light as usize, cell, &s.ray, &mut stats);
+            tests.add(&stats);
         });
     }
 
@@ -305,11 +307,11 @@ impl Structure {
         }
         order.sort_by_keys(keys + 1);
         // The segments are read out of order: fetch each a few answers ahead.
-        for (k, &i) in order.order.iter().enumerate() {
-            if let Some(&next) = order.order.get(k + PREFETCH_AHEAD) {
+        for (k, &(i, cell)) in order.order.iter().enumerate() {
+            if let Some(&(next, _)) = order.order.get(k + PREFETCH_AHEAD) {
                 prefetch_all(&segments[next as usize]);
             }
-            answer(i as usize, order.cells[i as usize]);
+            answer(i as usize, cell);
         }
     }
 

@@ -59,9 +59,12 @@ pub trait PathObserver {
 /// Everything a path needs, shared by every thread.
 pub struct Integrator<'a> {
     triangles: &'a [Triangle],
-    /// Per triangle, its material's diffuse colour and emission.
-    albedo: Vec<Vec3>,
-    emission: Vec<Vec3>,
+    /// Per triangle, its material's index in `shading` (the scene's own indices, which a
+    /// quarter of the memory of per-triangle colours keeps in the caches).
+    material: &'a [u32],
+    /// Per material, its diffuse colour and emission; the last entry is for a triangle whose
+    /// index names no material.
+    shading: Vec<Shading>,
     lights: &'a LightSet,
     structure: &'a Structure,
     max_bounces: u32,
@@ -92,19 +95,24 @@ impl<'a> Integrator<'a> {
                 }
             }
         }
-        let material = |i: usize| scene.materials.get(scene.material[i] as usize);
-        let albedo = (0..scene.len())
-            .map(|i| Vec3::from(material(i).map_or(DEFAULT_DIFFUSE, |m| m.diffuse)))
-            .collect();
-        let emission = (0..scene.len())
-            .map(|i| Vec3::from(material(i).map_or([0.0; 3], |m| m.emission)))
+        let shading = scene
+            .materials
+            .iter()
+            .map(|m| Shading {
+                albedo: Vec3::from(m.diffuse),
+                emission: Vec3::from(m.emission),
+            })
+            .chain([Shading {
+                albedo: Vec3::from(DEFAULT_DIFFUSE),
+                emission: Vec3::ZERO,
+            }])
             .collect();
         let b = scene.bounds;
         let scale = b.min.abs().max(b.max.abs()).max_element();
         Ok(Self {
             triangles: &scene.triangles,
-            albedo,
-            emission,
+            material: &scene.material,
+            shading,
             lights,
             structure,
             max_bounces,
@@ -173,12 +181,9 @@ impl<'a> Integrator<'a> {
             observer.closest(depth, &ray, found.as_ref().map(|(hit, _)| hit));
             let Some((hit, t)) = found else { break };
             let id = hit.triangle as usize;
-            // The material's entries are read after the light sample: fetched now, they
-            // arrive meanwhile, where read here they were the costliest load of the shading.
-            prefetch(&self.albedo[id]);
-            if depth == 0 {
-                prefetch(&self.emission[id]);
-            }
+            // The material's index is read after the light sample: fetched now, it arrives
+            // meanwhile, where read here it was the costliest load of the shading.
+            prefetch(&self.material[id]);
             // The hit point from the barycentrics: on the triangle up to rounding, wherever the
             // ray started. The edges are the leaf block's, bit for bit `v1 - v0` and `v2 - v0`
             // of the scene's triangle, which is not read: the block is in the caches, the
@@ -214,10 +219,11 @@ impl<'a> Integrator<'a> {
                     }
                 }
             }
+            let shading = &self.shading[(self.material[id] as usize).min(self.shading.len() - 1)];
             if depth == 0 {
-                sink.term(throughput * self.emission[id], Gate::Open);
+                sink.term(throughput * shading.emission, Gate::Open);
             }
-            let albedo = self.albedo[id];
+            let albedo = shading.albedo;
             if let Some((gate, weight, geometry)) = lit {
                 sink.term(throughput * albedo * weight * geometry, gate);
             }
@@ -241,6 +247,13 @@ impl<'a> Integrator<'a> {
             }
         }
     }
+}
+
+/// A material as the integrator shades it.
+#[derive(Clone, Copy, Debug)]
+struct Shading {
+    albedo: Vec3,
+    emission: Vec3,
 }
 
 /// What must hold for a vertex's radiance term to count.

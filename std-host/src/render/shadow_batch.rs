@@ -117,11 +117,6 @@ impl PathBatch {
         self.path_ends.clear();
     }
 
-    /// Paths in the batch.
-    pub fn paths(&self) -> usize {
-        self.path_ends.len()
-    }
-
     /// Ends the current path: the terms since the last end are its.
     pub(super) fn end_path(&mut self) {
         self.path_ends.push(self.terms.len() as u32);

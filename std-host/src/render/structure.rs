@@ -201,33 +201,25 @@ impl Structure {
     /// Whether anything blocks the shadow segment `ray` toward light `light`.
     #[inline]
     pub fn occluded(&self, light: usize, ray: &Ray) -> bool {
-        if let Some(t) = &self.thesis {
-            return t.occluded(ray);
-        }
-        let buffer = self.buffer_of[light];
-        if buffer != NO_BUFFER {
-            if let Some(answer) = self.buffers[buffer as usize].occluded(&self.global, ray) {
-                return answer;
-            }
-        }
-        self.global().any_hit(ray)
+        self.occluded_in(light, self.cell(light, ray), ray, &mut ())
     }
 
     /// [`Structure::occluded`], counting node and triangle tests in `stats` (a light buffer's
     /// cell lookup, and the `thesis` octree's, counts as one inner node).
     #[inline]
     pub fn occluded_counted(&self, light: usize, ray: &Ray, stats: &mut TraversalStats) -> bool {
-        if let Some(t) = &self.thesis {
-            return t.occluded_counted(ray, stats);
+        self.occluded_in(light, self.cell(light, ray), ray, stats)
+    }
+
+    /// The light buffer cell that answers the segment `ray` toward `light`, or `NO_CELL`.
+    #[inline(always)]
+    fn cell(&self, light: usize, ray: &Ray) -> u32 {
+        match self.buffer_of[light] {
+            NO_BUFFER => NO_CELL,
+            b => self.buffers[b as usize]
+                .cell_of(&self.global, ray)
+                .unwrap_or(NO_CELL),
         }
-        let buffer = self.buffer_of[light];
-        if buffer != NO_BUFFER {
-            let buffer = &self.buffers[buffer as usize];
-            if let Some(answer) = buffer.occluded_with_stats(&self.global, ray, stats) {
-                return answer;
-            }
-        }
-        self.global().any_hit_with_stats(ray, stats)
     }
 
     /// Whether this structure answers shadow segments fastest in batches
@@ -243,6 +235,7 @@ impl Structure {
     /// [`Structure::occluded`] does, in the order this structure answers fastest: `lights`
     /// takes them cell by cell of its light buffers (each cell's segments in their order, then
     /// those no buffer answers), the others as given. `order` is scratch kept between batches.
+    /// Panics if `answers` is shorter than `segments`.
     pub fn occluded_batch(
         &self,
         segments: &[ShadowRay],
@@ -295,15 +288,12 @@ impl Structure {
         order.cells.clear();
         order.keys.clear();
         for s in segments {
-            let buffer = self.buffer_of[s.light as usize];
-            let cell = match buffer {
-                NO_BUFFER => None,
-                b => self.buffers[b as usize].cell_of(&self.global, &s.ray),
-            };
-            order.cells.push(cell.unwrap_or(NO_CELL));
-            order
-                .keys
-                .push(cell.map_or(keys as u32, |c| order.bases[buffer as usize] + c));
+            let cell = self.cell(s.light as usize, &s.ray);
+            order.cells.push(cell);
+            order.keys.push(match cell {
+                NO_CELL => keys as u32,
+                c => order.bases[self.buffer_of[s.light as usize] as usize] + c,
+            });
         }
         order.sort_by_keys(keys + 1);
         // The segments are read out of order: fetch each a few answers ahead.

@@ -50,18 +50,26 @@ fn room() -> Vec<&'static str> {
     a
 }
 
+/// Writes a lights file with a point light under the room's ceiling, whose buffer the pilot
+/// frame keeps (the room's own ceiling quad is wide next to its shadow segments, and the pilot
+/// drops its buffer).
+fn point_light_under_the_ceiling(dir: &Path) -> PathBuf {
+    let file = dir.join("point.toml");
+    std::fs::write(
+        &file,
+        "[[light]]\nkind = \"point\"\nposition = [5.0, 4.5, 5.0]\nintensity = [20.0, 20.0, 20.0]\n",
+    )
+    .unwrap();
+    file
+}
+
 #[test]
 fn images_depend_on_the_seed_alone_whatever_the_threads_and_structure() {
     let dir = scratch("determinism");
     // The room's ceiling quad is wide next to its shadow segments, and the pilot frame drops
     // its buffer; a point light under the ceiling keeps one, so that all three structures
     // answer.
-    let lights_file = dir.join("point.toml");
-    std::fs::write(
-        &lights_file,
-        "[[light]]\nkind = \"point\"\nposition = [5.0, 4.5, 5.0]\nintensity = [20.0, 20.0, 20.0]\n",
-    )
-    .unwrap();
+    let lights_file = point_light_under_the_ceiling(&dir);
     let mut scene = room();
     scene.extend(["--lights", lights_file.to_str().unwrap()]);
     let one = render(&scene, &dir.join("one.png"), &["--threads", "1"]);
@@ -122,12 +130,7 @@ fn images_depend_on_the_seed_alone_whatever_the_threads_and_structure() {
 #[test]
 fn batches_of_tiles_change_neither_the_image_nor_the_counts() {
     let dir = scratch("batches");
-    let lights_file = dir.join("point.toml");
-    std::fs::write(
-        &lights_file,
-        "[[light]]\nkind = \"point\"\nposition = [5.0, 4.5, 5.0]\nintensity = [20.0, 20.0, 20.0]\n",
-    )
-    .unwrap();
+    let lights_file = point_light_under_the_ceiling(&dir);
     // 6 x 4 tiles: batches of 6 tiles on one thread, of 3 on two.
     let mut scene = ROOM[..7].to_vec();
     scene.extend(["--width", "96", "--height", "64", "--spp", "2"]);

@@ -426,6 +426,52 @@ mod tests {
     }
 
     #[test]
+    fn paths_in_a_batch_give_each_path_alone_bit_for_bit() {
+        // A floor under a point light, with a box on it that casts a shadow, through a light
+        // buffer: the batch answers cell by cell, out of the paths' order.
+        let mut scene = floor();
+        let (lo, hi) = (Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 1.0, 1.0));
+        for axis in 0..3 {
+            for side in [lo, hi] {
+                let mut c = [lo, lo, lo, lo];
+                for (k, corner) in c.iter_mut().enumerate() {
+                    let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                    corner[axis] = side[axis];
+                    corner[u] = if k & 1 == 0 { lo[u] } else { hi[u] };
+                    corner[v] = if k & 2 == 0 { lo[v] } else { hi[v] };
+                }
+                scene.triangles.push(Triangle::new(c[0], c[1], c[3]));
+                scene.triangles.push(Triangle::new(c[0], c[3], c[2]));
+                scene.material.extend([0, 0]);
+                scene.emissive.extend([false, false]);
+            }
+        }
+        let light = Light::Point {
+            position: Vec3::new(0.5, 3.0, 0.2),
+            intensity: Vec3::splat(10.0),
+        };
+        let lights = LightSet::new(vec![light], &scene.triangles).unwrap();
+        let structure =
+            Structure::build(StructureKind::Lights, &scene.triangles, lights.lights()).unwrap();
+        assert!(structure.answers_in_batches());
+        let integrator = Integrator::new(&scene, &lights, &structure, 3).unwrap();
+        let mut batch = PathBatch::default();
+        let mut alone = Vec::new();
+        for i in 0..256u32 {
+            let dir = Vec3::new(i as f32 / 64.0 - 2.0, -1.0, (i % 17) as f32 / 8.0 - 1.0);
+            let ray = Ray::new(Vec3::new(0.0, 4.0, 0.0), dir).unwrap();
+            let sampler = Sampler::new(5, u64::from(i), 0);
+            alone.push(integrator.radiance(ray, &sampler, &mut Ignore));
+            integrator.trace(ray, &sampler, &mut Ignore, &mut batch);
+        }
+        integrator.answer(&mut batch);
+        let batched: Vec<Vec3> = batch.radiance().collect();
+        assert_eq!(batched, alone);
+        let blocked = batch.segments.iter().filter(|s| s.occluded).count();
+        assert!(blocked > 0 && blocked < batch.segments.len(), "{blocked}");
+    }
+
+    #[test]
     fn cosine_directions_lie_in_the_hemisphere_with_mean_cosine_two_thirds() {
         for n in [
             Vec3::Y,

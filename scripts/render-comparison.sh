@@ -3,8 +3,8 @@
 # on the built-in room and four scenes of ../shared/scenes (512 x 512, 16 samples, 3 bounces, the
 # same seed), one markdown row per scene and structure, each ratio against `global` of the same
 # run. Each row checks that its PNG is byte-identical to `global`'s. The three structures run in
-# turn REPEATS times (default 3); every time is the best of its repeats, so that a shared machine's
-# load hits all three alike. Usage: [REPEATS=N] bash scripts/render-comparison.sh [SCENES_DIR]
+# turn REPEATS times (default 3), each repeat starting with the next one; every time is the best of
+# its repeats, so that a shared machine's load hits all three alike. Usage: [REPEATS=N] bash scripts/render-comparison.sh [SCENES_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scenes=${1:-../shared/scenes}
@@ -44,8 +44,12 @@ row() {
     local name=$1
     shift
     rm -f "$work"/*.json
+    local order=(global lights thesis)
     for r in $(seq "${REPEATS:-3}"); do
-        for s in global lights thesis; do
+        # Each repeat starts with another structure, so that none always runs first (after the
+        # previous scene) or last.
+        for k in 0 1 2; do
+            local s=${order[$(((r + k) % 3))]}
             "$bin" render "$@" --structure "$s" --out "$work/$s.png" --json | tail -n 1 >"$work/$s.$r.json"
         done
     done

@@ -4,7 +4,8 @@
 # same seed), one markdown row per scene and structure, each ratio against `global` of the same
 # run. Each row checks that its PNG is byte-identical to `global`'s. The three structures run in
 # turn REPEATS times (default 3), each repeat starting with the next one; every time is the best of
-# its repeats, so that a shared machine's load hits all three alike. Usage: [REPEATS=N] bash scripts/render-comparison.sh [SCENES_DIR]
+# its repeats, so that a shared machine's load hits all three alike.
+# Usage: [REPEATS=N] bash scripts/render-comparison.sh [SCENES_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scenes=${1:-../shared/scenes}

@@ -4,7 +4,8 @@
 # same seed), one markdown row per scene and structure, each ratio against `global` of the same
 # run. Each row checks that its PNG is byte-identical to `global`'s. The three structures run in
 # turn REPEATS times (default 3), each repeat starting with the next one; every time is the best of
-# its repeats, so that a shared machine's load hits all three alike.
+# its repeats, so that a shared machine's load hits all three alike. In brackets after frame + build,
+# the median over the repeats of each repeat's ratio to global's in that repeat.
 # Usage: [REPEATS=N] bash scripts/render-comparison.sh [SCENES_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -60,8 +61,11 @@ row() {
     python3 - "$name" "$same_l" "$same_t" "$work" <<'PY'
 import glob, json, sys
 name, same_l, same_t, work = sys.argv[1:]
+def repeats(s):
+    return {f.split(".")[-2]: json.load(open(f)) for f in glob.glob(f"{work}/{s}.*.json")}
 def best(s):
-    runs = [json.load(open(f)) for f in sorted(glob.glob(f"{work}/{s}.*.json"))]
+    by_repeat = repeats(s)
+    runs = list(by_repeat.values())
     j = dict(runs[0])
     for key in ("shadow_ms", "render_ms", "build_ms"):
         j[key] = min(r[key] for r in runs)
@@ -69,6 +73,15 @@ def best(s):
     # The light buffers and the choice among them, apart from the global BVH and the pilot.
     j["buffers_x"] = min((r["build_ms"] - r["global_build_ms"] - r["pilot_ms"]) / r["global_build_ms"]
                          for r in runs)
+    # Each repeat's frame + build over global's in the same repeat (the three ran back to
+    # back), the median over the repeats: steadier than a ratio of bests when the machine's
+    # speed drifts between repeats.
+    g_by_repeat = repeats("global")
+    ratios = sorted((r["render_ms"] + r["build_ms"])
+                    / (g_by_repeat[k]["render_ms"] + g_by_repeat[k]["build_ms"])
+                    for k, r in by_repeat.items())
+    j["paired_x"] = ratios[len(ratios) // 2] if len(ratios) % 2 else \
+        (ratios[len(ratios) // 2 - 1] + ratios[len(ratios) // 2]) / 2
     return j
 g, l, t = (best(s) for s in ("global", "lights", "thesis"))
 def tests(j):
@@ -90,12 +103,12 @@ for j, same in ((g, "-"), (l, same_l), (t, same_t)):
           f"| {j['shadow_ms']:.0f} ms (**{j['shadow_ms'] / g['shadow_ms']:.2f}x**) "
           f"| {j['render_ms']:.0f} ms ({j['render_ms'] / g['render_ms']:.2f}x) "
           f"| {j['build_ms']:.0f} ms ({j['build_ms'] / g['build_ms']:.2f}x) {parts(j)} "
-          f"| {j['total_ms'] / g['total_ms']:.2f}x | {same} |")
+          f"| {j['total_ms'] / g['total_ms']:.2f}x ({j['paired_x']:.2f}x) | {same} |")
 PY
 }
 
 size=(--width 512 --height 512 --spp 16 --max-bounces 3)
-echo "| scene, light | structure | triangles | shadow rays | nodes + triangles a shadow ray | shadow_ms (1 thread) | frame | build | frame + build | same PNG |"
+echo "| scene, light | structure | triangles | shadow rays | nodes + triangles a shadow ray | shadow_ms (1 thread) | frame | build | frame + build (paired) | same PNG |"
 echo "|---|---|---|---|---|---|---|---|---|---|"
 row "room, emissive quad" builtin:room --eye 5,5,0.3 --look-at 5,4,10 --fov 75 "${size[@]}"
 if [ -d "$scenes" ]; then

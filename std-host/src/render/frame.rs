@@ -37,7 +37,10 @@ pub const BATCH_SAMPLES: usize = 1 << 15;
 
 /// Batches per thread in one group: enough to balance the threads, few enough that a group's
 /// kept rays stay small. A frame has at least this many batches per thread where it has the
-/// tiles, however few samples they hold.
+/// tiles, however few samples they hold. A frame traced one tile a task (no batches) puts as many
+/// tiles in a group as a batched frame does, so that both wait for a group's last task and merge
+/// a group's output equally often: in groups of this many single tiles, the global BVH's Sponza
+/// frame kept its threads busy 91-92 % of the time, against 95 % in groups of as many tiles.
 const BATCHES_PER_THREAD: usize = 4;
 
 thread_local! {
@@ -203,15 +206,19 @@ pub fn render_frame(integrator: &Integrator, camera: &Camera, settings: &FrameSe
     };
     let threads = rayon::current_num_threads().max(1);
     let samples_per_tile = (TILE * TILE) as usize * settings.spp.max(1) as usize;
-    // A structure that answers each shadow segment where it is made needs no batch but a tile.
-    let per_batch = match integrator.batched() {
-        true => BATCH_SAMPLES.div_ceil(samples_per_tile),
-        false => 1,
-    }
-    .min(tiles / (threads * BATCHES_PER_THREAD))
-    .max(1);
+    let tiles_per_batch = BATCH_SAMPLES
+        .div_ceil(samples_per_tile)
+        .min(tiles / (threads * BATCHES_PER_THREAD))
+        .max(1);
+    // A structure that answers each shadow segment where it is made needs no batch but a tile;
+    // its groups span as many tiles as the batched ones (see `BATCHES_PER_THREAD`).
+    let per_batch = if integrator.batched() {
+        tiles_per_batch
+    } else {
+        1
+    };
     let batches = tiles.div_ceil(per_batch);
-    let group = threads * BATCHES_PER_THREAD;
+    let group = threads * BATCHES_PER_THREAD * tiles_per_batch / per_batch;
     for first in (0..batches).step_by(group) {
         let room = |kept: usize, cap: usize| cap.saturating_sub(kept);
         let shadow_room = room(frame.shadow_rays.len(), REPLAY_CAP);

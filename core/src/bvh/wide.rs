@@ -262,12 +262,14 @@ impl<const W: usize> WideBvhN<W> {
             + self.tris.len() * core::mem::size_of::<Triangle4>()
     }
 
-    /// Reorders every node's children by `key` of their boxes, largest first, the unused slots
-    /// last. Unordered traversals (any hit, the all-hit count) descend first into the lowest
-    /// slot the ray hits, so for rays of a known direction this sends an any-hit query first
-    /// into the child likeliest to end it; answers do not change, only the work before them.
-    pub(crate) fn order_children(&mut self, key: impl Fn(&Aabb) -> f32) {
-        self.sort_slots(|node, i| -f64::from(key(&node.child_bounds(i))));
+    /// Reorders the children of every node from node `first` on (the last tree of a forest, a
+    /// node array holding several trees) by `key` of their boxes, largest first, the unused
+    /// slots last.
+    /// Unordered traversals (any hit, the all-hit count) descend first into the lowest slot the
+    /// ray hits, so for rays of a known direction this sends an any-hit query first into the
+    /// child likeliest to end it; answers do not change, only the work before them.
+    pub(crate) fn order_children(&mut self, first: usize, key: impl Fn(&Aabb) -> f32) {
+        self.sort_slots(first, |node, i| -f64::from(key(&node.child_bounds(i))));
     }
 
     /// Reorders every node's children so that the one holding the fewest triangles comes first,
@@ -290,16 +292,16 @@ impl<const W: usize> WideBvhN<W> {
                 .sum();
         }
         let inner_after_leaf = 0.5;
-        self.sort_slots(|node, k| match node.count[k] {
+        self.sort_slots(0, |node, k| match node.count[k] {
             0 => triangles[node.child[k] as usize] as f64 + inner_after_leaf,
             n => f64::from(n),
         });
     }
 
-    /// Reorders every node's children by `key(node, slot)`, smallest first (a stable sort), the
-    /// unused slots last.
-    fn sort_slots(&mut self, key: impl Fn(&WideNodeN<W>, usize) -> f64) {
-        for node in &mut self.nodes {
+    /// Reorders the children of every node from node `first` on by `key(node, slot)`, smallest
+    /// first (a stable sort), the unused slots last.
+    fn sort_slots(&mut self, first: usize, key: impl Fn(&WideNodeN<W>, usize) -> f64) {
+        for node in &mut self.nodes[first..] {
             let mut slots: [usize; W] = core::array::from_fn(|i| i);
             let keys: [f64; W] = core::array::from_fn(|i| {
                 if node.child[i] == WideNodeN::<W>::EMPTY {
@@ -314,29 +316,6 @@ impl<const W: usize> WideBvhN<W> {
                 node.set(i, old.child_bounds(from), old.child[from], old.count[from]);
             }
         }
-    }
-
-    /// Appends `other`'s nodes and blocks after this tree's, its indices rebased, and returns the
-    /// index of its root node (`None` for an empty `other`): one allocation holds a forest of
-    /// trees, each traversed from its own root ([`WideBvh::any_hit_from`]), laid out in the order
-    /// they were appended. The result's own root, bounds and root box stay this tree's.
-    pub(crate) fn append(&mut self, other: &Self) -> Option<u32> {
-        if other.nodes.is_empty() {
-            return None;
-        }
-        let (nodes, blocks) = (self.nodes.len() as u32, self.tris.len() as u32);
-        self.nodes.extend(other.nodes.iter().map(|node| {
-            let mut node = *node;
-            for (child, &count) in node.child.iter_mut().zip(&node.count) {
-                if *child != WideNodeN::<W>::EMPTY {
-                    *child += if count == 0 { nodes } else { blocks };
-                }
-            }
-            node
-        }));
-        self.tris.extend_from_slice(&other.tris);
-        self.max_depth = self.max_depth.max(other.max_depth);
-        Some(nodes)
     }
 }
 
@@ -498,7 +477,7 @@ mod tests {
         let wide = WideBvh8::from_binary(&bvh, &tris);
         let mut ordered = wide.clone();
         let key = |b: &Aabb| b.center().x - b.center().y;
-        ordered.order_children(key);
+        ordered.order_children(0, key);
         for node in &ordered.nodes {
             let used = node.arity();
             assert!(node.child[used..]

@@ -683,11 +683,11 @@ where
         self.any_hit_from(0, &self.tris, ray, stats)
     }
 
-    /// [`WideBvh::any_hit_with_stats`] from node `root` of a forest ([`WideBvh::append`]) whose
-    /// leaves name blocks of `tris` (its own, or another tree's: a light buffer's cell trees
-    /// point into the scene BVH's blocks), with no root-box test: a tree the caller chose for
-    /// the ray. Runs [`WideBvh::any_from_root`], through the AVX2 entry point where the CPU has
-    /// it.
+    /// [`WideBvh::any_hit_with_stats`] from node `root` of a forest (one node array holding
+    /// several trees) whose leaves name blocks of `tris` (its own, or another tree's: a light
+    /// buffer's cell trees point into the scene BVH's blocks), with no root-box test: a tree the
+    /// caller chose for the ray. Runs [`WideBvh::any_from_root`], through the AVX2 entry point
+    /// where the CPU has it.
     #[inline(always)]
     pub(crate) fn any_hit_from(
         &self,

@@ -93,14 +93,17 @@ pub struct LightBuffer {
     pub(crate) source: LightSource,
     /// Cells a side on each face of the finest grid.
     pub(crate) resolution: u32,
-    /// Per finest cell, `face * r * r + v * r + u`: the root node of its tree in `forest`,
-    /// [`CLEAR`] or [`DARK`].
+    /// Per finest cell, `face * r * r + v * r + u`: the root node of its tree in its face's
+    /// forest, [`CLEAR`] or [`DARK`].
     pub(crate) grid: Vec<u32>,
-    /// Every cell's tree in one node array, in the order the quadtree's depth-first walk made
-    /// them (neighbouring cells' trees lie side by side in memory). It holds no triangles: each
-    /// leaf names a leaf's blocks in the scene BVH, whose triangles the renderer's other rays
-    /// keep in the caches.
-    pub(crate) forest: WideBvh8,
+    /// Per cube-map face, every cell's tree in one node array, in the order the quadtree's
+    /// depth-first walk made them (neighbouring cells' trees lie side by side in memory). Each
+    /// face keeps the array its build made: joined into one, the copy of a large buffer's nodes
+    /// took a fifth of its build. It holds no triangles: each leaf names a leaf's blocks in the
+    /// scene BVH, whose triangles the renderer's other rays keep in the caches.
+    pub(crate) forests: Vec<WideBvh8>,
+    /// `log2(r * r)`: a grid cell's face is its index shifted right by this.
+    pub(crate) face_shift: u32,
     /// The scene BVH's node and block counts, checked at each query.
     pub(crate) scene_size: (usize, usize),
     /// The length margin of every decision ([`super::source::MARGIN`] times the coordinate scale).
@@ -230,7 +233,14 @@ impl LightBuffer {
         match *self.grid.get(cell as usize)? {
             DARK => None,
             CLEAR => Some(false),
-            root => Some(self.forest.any_hit_from(root, &scene.tris, ray, stats)),
+            root => Some(
+                self.forests[(cell >> self.face_shift) as usize].any_hit_from(
+                    root,
+                    &scene.tris,
+                    ray,
+                    stats,
+                ),
+            ),
         }
     }
 

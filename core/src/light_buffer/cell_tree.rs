@@ -70,6 +70,8 @@ pub(crate) struct CellTreeBuilder {
     bvh: Bvh,
     items: Vec<(u32, Aabb)>,
     item_of: Vec<u32>,
+    /// The collapse's pending wide nodes: index, binary node, depth.
+    pending: Vec<(usize, u32, u32)>,
 }
 
 impl CellTreeBuilder {
@@ -79,16 +81,19 @@ impl CellTreeBuilder {
             bvh: Bvh::default(),
             items: Vec::new(),
             item_of: Vec::new(),
+            pending: Vec::new(),
         }
     }
 
     /// The tree over the scene leaves of `reached` (triangle ids with the boxes of their parts
-    /// in the cell) and the triangles of those leaves; `None` when nothing is reached.
+    /// in the cell), appended to `forest` (whose leaves name the scene's blocks, as its own):
+    /// its root and the triangles of those leaves; `None` when nothing is reached.
     pub(crate) fn build(
         &mut self,
         reached: impl Iterator<Item = (u32, Aabb)>,
         scene: &SceneLeaves,
-    ) -> Result<Option<(WideBvh8, usize)>, BuildError> {
+        forest: &mut WideBvh8,
+    ) -> Result<Option<(u32, usize)>, BuildError> {
         if self.item_of.len() != scene.leaves.len() {
             self.item_of = vec![u32::MAX; scene.leaves.len()];
         }
@@ -127,17 +132,21 @@ impl CellTreeBuilder {
             .iter()
             .map(|&(leaf, _)| scene.leaves[leaf as usize].1 as usize)
             .sum();
-        Ok(Some((self.collapse(scene)?, triangles)))
+        Ok(Some((self.collapse(scene, forest)?, triangles)))
     }
 
-    /// The binary tree as 8-wide nodes: each wide node takes its binary node's children and
-    /// opens the inner one of largest area while it has room, as `WideBvh8::from_binary` does
-    /// without its leaf blocks; each binary leaf becomes the slot of its scene leaf.
-    fn collapse(&self, scene: &SceneLeaves) -> Result<WideBvh8, BuildError> {
+    /// The binary tree as 8-wide nodes appended to `out`, and its root: each wide node takes its
+    /// binary node's children and opens the inner one of largest area while it has room, as
+    /// `WideBvh8::from_binary` does without its leaf blocks; each binary leaf becomes the slot of
+    /// its scene leaf. Written in place: collapsed into a tree of its own and then appended, the
+    /// nodes were copied once more, and a large buffer's build spent a fifth of its time on it.
+    fn collapse(&mut self, scene: &SceneLeaves, out: &mut WideBvh8) -> Result<u32, BuildError> {
         let nodes = &self.bvh.nodes;
-        let mut out = WideBvh8::default();
+        let root = out.nodes.len();
         out.nodes.push(WideNodeN::UNUSED);
-        let mut pending = vec![(0usize, 0u32, 0u32)];
+        let pending = &mut self.pending;
+        pending.clear();
+        pending.push((root, 0u32, 0u32));
         let mut open = Vec::with_capacity(8);
         while let Some((wide, binary, depth)) = pending.pop() {
             out.max_depth = out.max_depth.max(depth);
@@ -178,6 +187,6 @@ impl CellTreeBuilder {
                 }
             }
         }
-        Ok(out)
+        Ok(root as u32)
     }
 }

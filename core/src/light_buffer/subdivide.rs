@@ -176,7 +176,8 @@ impl<'a> LightBufferBuilder<'a> {
             source: self.source,
             resolution: self.resolution,
             grid: vec![DARK; FACES * r * r],
-            forest: WideBvh8::default(),
+            forests: vec![WideBvh8::default(); FACES],
+            face_shift: 2 * self.options.max_level,
             margin: self.margin as f32,
             scene_size: self.scene.size,
             stats: LightBufferStats::default(),
@@ -188,15 +189,8 @@ impl<'a> LightBufferBuilder<'a> {
                     "light buffer faces from another build or given twice",
                 ));
             }
-            let base = out.forest.append(&face.forest).unwrap_or(0);
-            let cells = &mut out.grid[face.face * r * r..(face.face + 1) * r * r];
-            for (cell, &slot) in cells.iter_mut().zip(&face.grid) {
-                *cell = if slot == DARK || slot == CLEAR {
-                    slot
-                } else {
-                    slot + base
-                };
-            }
+            out.grid[face.face * r * r..(face.face + 1) * r * r].copy_from_slice(&face.grid);
+            out.forests[face.face] = face.forest;
             let (s, f) = (&mut out.stats, face.stats);
             s.trees += f.trees;
             s.clear_cells += f.clear_cells;
@@ -206,7 +200,8 @@ impl<'a> LightBufferBuilder<'a> {
         if seen.contains(&false) {
             return Err(BuildError::InvalidConfig("light buffer face missing"));
         }
-        out.stats.memory_bytes = out.grid.len() * 4 + out.forest.memory_bytes();
+        out.stats.memory_bytes =
+            out.grid.len() * 4 + out.forests.iter().map(|f| f.memory_bytes()).sum::<usize>();
         Ok(out)
     }
 }
@@ -318,17 +313,18 @@ impl Leaf {
                 .clipped_bounds(&build.tris[id as usize])
                 .map(|bounds| (id, bounds))
         });
-        let slot = match self.tree.build(reached, &build.scene)? {
+        let slot = match self.tree.build(reached, &build.scene, &mut out.forest)? {
             None => {
                 out.stats.clear_cells += 1;
                 CLEAR
             }
-            Some((mut tree, triangles)) => {
+            Some((root, triangles)) => {
                 out.stats.trees += 1;
                 out.stats.references += triangles;
                 let light = build.source.bounds.center();
-                tree.order_children(|b| -b.center().distance_squared(light));
-                out.forest.append(&tree).unwrap_or(CLEAR)
+                out.forest
+                    .order_children(root as usize, |b| -b.center().distance_squared(light));
+                root
             }
         };
         let span = 1u32 << (build.options.max_level - task.level);

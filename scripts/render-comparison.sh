@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The README's rendering table: `rdbvh render` through `--structure global`, `lights` and `thesis`
-# on the built-in room and four scenes of ../shared/scenes (512 x 512, 16 samples, 3 bounces, the
-# same seed), one markdown row per scene and structure, each ratio against `global` of the same
-# run. Each row checks that its PNG is byte-identical to `global`'s. The three structures run in
-# turn REPEATS times (default 3), each repeat starting with the next one; every time is the best of
-# its repeats, so that a shared machine's load hits all three alike. In brackets after frame + build,
+# on the built-in room and four scenes of ../shared/scenes, Sponza twice (a point light, and a
+# quad light 100 units a side), at 512 x 512, 16 samples, 3 bounces and the same seed: one
+# markdown row per scene and structure, each ratio against `global` of the same run. Each row
+# checks that its PNG is byte-identical to `global`'s. The three structures run in turn REPEATS
+# times (default 3), each repeat starting with the next one; every time is the best of its
+# repeats, so that a shared machine's load hits all three alike. In brackets after frame + build,
 # the median over the repeats of each repeat's ratio to global's in that repeat.
 # Usage: [REPEATS=N] bash scripts/render-comparison.sh [SCENES_DIR]
 set -euo pipefail
@@ -19,6 +20,14 @@ cat >"$work/sponza.toml" <<'TOML'
 kind = "point"
 position = [0.0, 800.0, 0.0]
 intensity = [400000.0, 380000.0, 340000.0]
+TOML
+cat >"$work/sponza-quad.toml" <<'TOML'
+[[light]]
+kind = "quad"
+corner = [-50.0, 800.0, -50.0]
+edge1 = [100.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, 100.0]
+radiance = [40.0, 38.0, 34.0]
 TOML
 cat >"$work/sibenik.toml" <<'TOML'
 [[light]]
@@ -114,6 +123,8 @@ row "room, emissive quad" builtin:room --eye 5,5,0.3 --look-at 5,4,10 --fov 75 "
 if [ -d "$scenes" ]; then
     row "Cornell box, emissive quad" "$scenes/cornell_box.obj" "${size[@]}"
     row "Sponza, point light" "$scenes/sponza_crytek.obj" --lights "$work/sponza.toml" \
+        --eye 1100,200,-50 --look-at -900,400,0 --fov 60 "${size[@]}"
+    row "Sponza, quad light" "$scenes/sponza_crytek.obj" --lights "$work/sponza-quad.toml" \
         --eye 1100,200,-50 --look-at -900,400,0 --fov 60 "${size[@]}"
     row "Sibenik, point + spot + 1,719 emissive window triangles" "$scenes/sibenik.obj" \
         --lights "$work/sibenik.toml" --eye 1200,300,100 --look-at -1000,300,100 --fov 70 "${size[@]}"

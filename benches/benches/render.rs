@@ -49,7 +49,7 @@ struct Case {
     eye: Option<(Vec3, Vec3, f32)>,
 }
 
-const CASES: [Case; 3] = [
+const CASES: [Case; 4] = [
     Case {
         name: "room",
         scene: "builtin:room",
@@ -67,6 +67,18 @@ const CASES: [Case; 3] = [
         scene: "sponza_crytek",
         lights: "[[light]]\nkind = \"point\"\nposition = [0.0, 800.0, 0.0]\n\
                  intensity = [400000.0, 380000.0, 340000.0]\n",
+        eye: Some((
+            Vec3::new(1100.0, 200.0, -50.0),
+            Vec3::new(-900.0, 400.0, 0.0),
+            60.0,
+        )),
+    },
+    Case {
+        name: "sponza_quad",
+        scene: "sponza_crytek",
+        lights: "[[light]]\nkind = \"quad\"\ncorner = [-50.0, 800.0, -50.0]\n\
+                 edge1 = [100.0, 0.0, 0.0]\nedge2 = [0.0, 0.0, 100.0]\n\
+                 radiance = [40.0, 38.0, 34.0]\n",
         eye: Some((
             Vec3::new(1100.0, 200.0, -50.0),
             Vec3::new(-900.0, 400.0, 0.0),

@@ -91,7 +91,7 @@ pub struct LightBufferStats {
 #[derive(Clone, Debug)]
 pub struct LightBuffer {
     pub(crate) source: LightSource,
-    /// Cells a side on each face of the finest grid.
+    /// Cells a side on each face of the finest grid: a power of two, `1 << max_level`.
     pub(crate) resolution: u32,
     /// Per finest cell, `face * r * r + v * r + u`: the root node of its tree in its face's
     /// forest, [`CLEAR`] or [`DARK`].
@@ -102,8 +102,6 @@ pub struct LightBuffer {
     /// took a fifth of its build. It holds no triangles: each leaf names a leaf's blocks in the
     /// scene BVH, whose triangles the renderer's other rays keep in the caches.
     pub(crate) forests: Vec<WideBvh8>,
-    /// `log2(r * r)`: a grid cell's face is its index shifted right by this.
-    pub(crate) face_shift: u32,
     /// The scene BVH's node and block counts, checked at each query.
     pub(crate) scene_size: (usize, usize),
     /// The length margin of every decision ([`super::source::MARGIN`] times the coordinate scale).
@@ -233,14 +231,11 @@ impl LightBuffer {
         match *self.grid.get(cell as usize)? {
             DARK => None,
             CLEAR => Some(false),
-            root => Some(
-                self.forests[(cell >> self.face_shift) as usize].any_hit_from(
-                    root,
-                    &scene.tris,
-                    ray,
-                    stats,
-                ),
-            ),
+            root => {
+                // The cell's face: its index over `r * r`, a power of two.
+                let face = cell >> (2 * self.resolution.trailing_zeros());
+                Some(self.forests[face as usize].any_hit_from(root, &scene.tris, ray, stats))
+            }
         }
     }
 

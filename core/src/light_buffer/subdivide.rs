@@ -177,7 +177,6 @@ impl<'a> LightBufferBuilder<'a> {
             resolution: self.resolution,
             grid: vec![DARK; FACES * r * r],
             forests: vec![WideBvh8::default(); FACES],
-            face_shift: 2 * self.options.max_level,
             margin: self.margin as f32,
             scene_size: self.scene.size,
             stats: LightBufferStats::default(),

@@ -147,18 +147,20 @@ impl CellTreeBuilder {
         let pending = &mut self.pending;
         pending.clear();
         pending.push((root, 0u32, 0u32));
-        let mut open = Vec::with_capacity(8);
+        // The binary nodes a wide node takes, at most 8: on the stack, no allocation per node.
+        let mut open = [0u32; 8];
         while let Some((wide, binary, depth)) = pending.pop() {
             out.max_depth = out.max_depth.max(depth);
-            open.clear();
             let node = &nodes[binary as usize];
-            if node.count > 0 {
-                open.push(binary);
+            let mut len = if node.count > 0 {
+                open[0] = binary;
+                1
             } else {
-                open.extend([node.left_first, node.left_first + 1]);
-            }
-            while open.len() < 8 {
-                let widest = (0..open.len())
+                open[..2].copy_from_slice(&[node.left_first, node.left_first + 1]);
+                2
+            };
+            while len < 8 {
+                let widest = (0..len)
                     .filter(|&i| nodes[open[i] as usize].count == 0)
                     .max_by(|&a, &b| {
                         let area = |i: usize| nodes[open[i] as usize].bounds().surface_area();
@@ -167,9 +169,10 @@ impl CellTreeBuilder {
                 let Some(i) = widest else { break };
                 let left = nodes[open[i] as usize].left_first;
                 open[i] = left;
-                open.push(left + 1);
+                open[len] = left + 1;
+                len += 1;
             }
-            for (slot, &n) in open.iter().enumerate() {
+            for (slot, &n) in open[..len].iter().enumerate() {
                 let node = &nodes[n as usize];
                 if node.count == 0 {
                     let child = out.nodes.len();

@@ -265,17 +265,17 @@ impl<const W: usize> WideBvhN<W> {
     /// Reorders the children of every node from node `first` on (the last tree of a forest, a
     /// node array holding several trees) by `key` of their boxes, largest first, the unused
     /// slots last.
-    /// Unordered traversals (any hit, the all-hit count) descend first into the lowest slot the
-    /// ray hits, so for rays of a known direction this sends an any-hit query first into the
-    /// child likeliest to end it; answers do not change, only the work before them.
+    /// Unordered traversals (any hit, the all-hit count) visit the children a ray hits in slot
+    /// order, so for rays of a known direction this sends an any-hit query first into the child
+    /// likeliest to end it; answers do not change, only the work before them.
     pub(crate) fn order_children(&mut self, first: usize, key: impl Fn(&Aabb) -> f32) {
         self.sort_slots(first, |node, i| -f64::from(key(&node.child_bounds(i))));
     }
 
     /// Reorders every node's children so that the one holding the fewest triangles comes first,
     /// a leaf before an inner child of as many, ties in their collapse order. An any-hit query
-    /// descends first into the lowest slot the ray hits, and a small subtree is cheap to search,
-    /// so a shadow ray tries the cheap children before it commits to a large one: on the
+    /// visits the children it hits in slot order, and a small subtree is cheap to search, so a
+    /// shadow ray tries the cheap children before it commits to a large one: on the
     /// benches' any-hit rays this cut Sponza's node visits by a tenth to a quarter
     /// (benches/RESULTS.md). Closest-hit queries order by distance; no answer changes.
     pub(crate) fn order_fewest_first(&mut self) {

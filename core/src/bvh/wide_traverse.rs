@@ -747,8 +747,10 @@ where
     /// The loop every query shares, from node `root` (the root box test done or skipped by the
     /// caller). It keeps the node it is in rather than pushing and popping it: a node with one
     /// child hit goes straight on to it, and one with several pushes all but the one it goes to
-    /// (for an ordered visitor the nearest, the rest pushed farthest first). Generic over the
-    /// lanes `L` so that the AVX2 entry points ([`super::dispatch`]) instantiate the same loop.
+    /// (for an ordered visitor the nearest, the rest pushed farthest first; for an unordered
+    /// one the lowest slot, the rest pushed highest first, so that they are visited in slot
+    /// order). Generic over the lanes `L` so that the AVX2 entry points ([`super::dispatch`])
+    /// instantiate the same loop.
     #[inline(always)]
     pub(crate) fn walk<L: Lanes<W>, V: LeafVisitor>(
         &self,
@@ -795,10 +797,11 @@ where
                         if V::ORDERED {
                             push_ordered(&mut stack, node, t_near, first, rest)
                         } else {
+                            // Highest slot first, so that the pops come in slot order.
                             let mut m = rest;
                             while m != 0 {
-                                let i = m.trailing_zeros() as usize;
-                                m &= m - 1;
+                                let i = 31 - m.leading_zeros() as usize;
+                                m &= !(1 << i);
                                 stack.push((node.child[i], node.count[i], 0.0));
                             }
                             first

@@ -172,6 +172,8 @@ mod tests {
         let lights = image.with_file_name(format!("rdbvh-demo-{}-lights.toml", std::process::id()));
         assert!(lights.is_file(), "the demo's lights file beside its image");
         let text = String::from_utf8(out).unwrap();
+        // Checked, so removed: a test run leaves nothing in the temporary directory.
+        let _ = (std::fs::remove_file(&image), std::fs::remove_file(&lights));
         assert!(text.contains("agree with brute force"), "{text}");
     }
 }

@@ -913,6 +913,7 @@ fn push_ordered<const W: usize, V: ChildLanes<W>>(
 
 #[cfg(test)]
 mod tests {
+    use alloc::vec::Vec;
 
     use glam::Vec3;
 
@@ -967,6 +968,63 @@ mod tests {
                 assert_eq!(wide8.all_hit(&r).hits, brute_force::hit_count(&r, tris));
             }
         }
+    }
+
+    /// Records the leaves an unordered walk visits (by their first triangle id), never stopping.
+    struct LeafOrder {
+        t_max: f32,
+        leaves: Vec<u32>,
+    }
+
+    impl LeafVisitor for LeafOrder {
+        const ORDERED: bool = false;
+        fn t_max(&self) -> f32 {
+            self.t_max
+        }
+        fn leaf(&mut self, blocks: &[Triangle4], _count: u32) -> bool {
+            self.leaves.push(blocks[0].id[0]);
+            false
+        }
+    }
+
+    /// The leaves below `node` whose boxes the ray touches, depth first in slot order.
+    fn slot_order(wide: &crate::bvh::WideBvh8, r: &RayN<f32x8>, node: u32, out: &mut Vec<u32>) {
+        let node = &wide.nodes[node as usize];
+        let (_, mask) = r.intersect(node, f32::INFINITY);
+        for i in (0..8).filter(|i| mask & (1 << i) != 0) {
+            match node.count[i] {
+                0 => slot_order(wide, r, node.child[i], out),
+                _ => out.push(wide.triangles()[node.child[i] as usize].id[0]),
+            }
+        }
+    }
+
+    /// An unordered walk (any hit, the all-hit count) visits the children a ray hits in slot
+    /// order, so that the order `order_fewest_first` and the light buffers' cell trees set up is
+    /// the order an any-hit query tries them in.
+    #[test]
+    fn unordered_walks_visit_children_in_slot_order() {
+        let tris = crate::test_scenes::soup(3000, 41, -10.0, 10.0, 1.0);
+        let bvh = Builder::sah().build(&tris).unwrap();
+        let wide8 = crate::bvh::WideBvh8::from_binary(&bvh, &tris);
+        let mut rng = Pcg32::new(42);
+        let mut several = 0;
+        for _ in 0..500 {
+            let mut v = |s: f32| Vec3::new(rng.range(-s, s), rng.range(-s, s), rng.range(-s, s));
+            let Ok(ray) = Ray::new(v(12.0), v(1.0)) else {
+                continue;
+            };
+            let mut expect = Vec::new();
+            slot_order(&wide8, &RayN::new::<8>(&ray), 0, &mut expect);
+            let mut seen = LeafOrder {
+                t_max: ray.t_max,
+                leaves: Vec::new(),
+            };
+            wide8.walk::<Width<8>, _>(0, &ray, &mut seen, &mut TraversalStats::default());
+            assert_eq!(seen.leaves, expect);
+            several += usize::from(expect.len() > 2);
+        }
+        assert!(several > 100, "{several} rays reach three leaves or more");
     }
 
     /// The hit with edges is the closest hit, and its edges are the scene triangle's first

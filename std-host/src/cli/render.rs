@@ -207,8 +207,13 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
     })?;
     let (eye, look_at) = match scene.view {
         Some(view) => (view.eye, view.look_at),
+        // The framing camera only where it is used: a scene too large to frame still renders
+        // from the caller's own eye.
         None => (
-            Camera::framing(scene.bounds, args.fov, args.width, args.height)?.eye(),
+            match args.eye {
+                Some(eye) => eye,
+                None => Camera::framing(scene.bounds, args.fov, args.width, args.height)?.eye(),
+            },
             scene.bounds.center(),
         ),
     };

@@ -43,7 +43,19 @@ impl Camera {
                 "the image must not be empty, got {width} x {height}"
             ));
         }
-        let forward = (look_at - eye).normalize_or_zero();
+        let view = look_at - eye;
+        if !view.is_finite() {
+            return bad(format!(
+                "--eye {eye} and --look-at {look_at} are too far apart for single precision"
+            ));
+        }
+        // Squared, a view past 1.8e19 overflows f32 and would normalise to zero: such a view is
+        // scaled down first (others are not, so that their rays keep their bits).
+        let forward = if view.length_squared().is_finite() {
+            view.normalize_or_zero()
+        } else {
+            (view / view.abs().max_element()).normalize_or_zero()
+        };
         if forward == Vec3::ZERO || !forward.is_finite() {
             return bad("--eye and --look-at must differ".to_string());
         }
@@ -83,11 +95,25 @@ impl Camera {
         let aspect = width as f32 / height.max(1) as f32;
         let fit = (half.y / tan_y).max(half.x / (tan_y * aspect)) * 1.05;
         // A scene flat in x and y (or a single point) still needs the eye off its face.
+        // `|half|`, scaled down first where its square overflows f32 (see `Camera::new`).
+        let largest = half.max_element();
+        let length = if half.length_squared().is_finite() {
+            half.length()
+        } else {
+            (half / largest).length() * largest
+        };
         let distance = fit
-            .max(half.length() * 0.1)
+            .max(length * 0.1)
             .max(1e-3 * centre.abs().max_element())
             .max(1e-6);
         let eye = Vec3::new(centre.x, centre.y, bounds.max.z + distance);
+        if !eye.is_finite() || eye == centre {
+            return Err(RenderError::Camera(format!(
+                "the default camera cannot frame the scene's bounds {} to {} in single \
+                 precision (its eye would be at {eye}); give --eye and --look-at",
+                bounds.min, bounds.max
+            )));
+        }
         Self::new(eye, centre, Vec3::Y, fov_deg, width, height)
     }
 
@@ -144,6 +170,21 @@ mod tests {
         assert!(make(Vec3::ZERO, Vec3::Z, Vec3::Y, 180.0).contains("--fov"));
         assert!(make(Vec3::ZERO, Vec3::Z, Vec3::Y, f32::NAN).contains("--fov"));
         assert!(make(Vec3::splat(f32::NAN), Vec3::Z, Vec3::Y, 45.0).contains("--eye"));
+        let far = Vec3::splat(3e38);
+        assert!(make(-far, far, Vec3::Y, 45.0).contains("too far apart"));
+        // A long view still has a direction.
+        let c = Camera::new(Vec3::ZERO, Vec3::new(0.0, 0.0, 1e30), Vec3::Y, 45.0, 8, 8).unwrap();
+        assert_eq!(c.forward, Vec3::Z);
+    }
+
+    #[test]
+    fn framing_a_box_past_single_precision_is_refused() {
+        let b = Aabb::new(Vec3::ZERO, Vec3::splat(3e38));
+        let why = Camera::framing(b, 50.0, 8, 8).unwrap_err().to_string();
+        assert!(
+            why.contains("default camera") && why.contains("--eye"),
+            "{why}"
+        );
     }
 
     #[test]

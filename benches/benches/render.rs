@@ -133,8 +133,19 @@ impl Loaded {
             StructureKind::Lights => {
                 let size = pilot_size(SIZE.0, SIZE.1);
                 let camera = self.camera(size);
-                build_lights(&self.scene, &self.lights, BOUNCES, &camera, size, SEED)
-                    .map(|(s, _)| s)
+                // The buffers the comparison's full frame repays, whose shadow segments this
+                // smaller frame samples: at its own size, the pilot would find none worth it.
+                let full_frame = 512 * 512 * 16;
+                build_lights(
+                    &self.scene,
+                    &self.lights,
+                    BOUNCES,
+                    &camera,
+                    size,
+                    SEED,
+                    full_frame,
+                )
+                .map(|(s, _)| s)
             }
             kind => Structure::build(kind, &self.scene.triangles, self.lights.lights()),
         };

@@ -129,9 +129,11 @@ pub fn render() -> String {
          clustered per material, at most 32 buffers, for the most powerful lights), with the\n\
          global BVH for segments a buffer does not take. A pilot frame (1/8 of the resolution,\n\
          1 sample, traced through the global BVH first) decides: a light wider than half its\n\
-         pilot segments' median length gets no buffer built, and a buffer built is kept\n\
-         only where those segments need at most 0.7 of the global BVH's node + triangle tests\n\
-         through it; build_ms includes the pilot (global_build_ms is the global BVH's part,\n\
+         pilot segments' median length gets no buffer built, nor one whose pilot segments,\n\
+         scaled to the frame's samples, would save fewer tests (half of theirs through the\n\
+         global BVH) than 25 per scene triangle, about the buffer's build time; a buffer built\n\
+         is kept only where those segments need at most 0.7 of the global BVH's node +\n\
+         triangle tests through it; build_ms includes the pilot (global_build_ms is the global BVH's part,\n\
          pilot_ms the pilot frame's). With a buffer kept, paths are traced in batches of\n\
          consecutive tiles (about 32768 samples), and each batch's shadow segments are answered\n\
          together, cell by cell of the buffers, so that a cell's tree stays in the caches; the\n\

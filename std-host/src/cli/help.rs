@@ -133,11 +133,12 @@ pub fn render() -> String {
          scaled to the frame's samples, would save fewer tests (half of theirs through the\n\
          global BVH) than 25 per scene triangle, about the buffer's build time; a buffer built\n\
          is kept only where those segments need at most 0.7 of the global BVH's node +\n\
-         triangle tests through it; build_ms includes the pilot (global_build_ms is the global BVH's part,\n\
-         pilot_ms the pilot frame's). With a buffer kept, paths are traced in batches of\n\
-         consecutive tiles (about 32768 samples), and each batch's shadow segments are answered\n\
-         together, cell by cell of the buffers, so that a cell's tree stays in the caches; the\n\
-         radiance is then summed in each path's order, bit for bit as if answered one by one.\n\
+         triangle tests through it; build_ms includes the pilot (global_build_ms is the\n\
+         global BVH's part, pilot_ms the pilot frame's). With a buffer kept, paths are traced\n\
+         in batches of consecutive tiles (about 32768 samples), and each batch's shadow\n\
+         segments are answered together, cell by cell of the buffers, so that a cell's tree\n\
+         stays in the caches; the radiance is then summed in each path's order, bit for bit\n\
+         as if answered one by one.\n\
          thesis, the thesis's own structure with influence areas made from the lights: six\n\
          90-degree frustums around a point light (one per cube face, apex at the light, to the\n\
          scene's far end), one frustum along a spot of at most 120 degrees (six for a wider one),\n\

@@ -115,7 +115,8 @@ pub struct RenderReport {
     pub light_buffers_dropped: usize,
     /// Of those dropped, the ones never built: the light is too wide next to its pilot shadow
     /// segments' lengths for a buffer to pay (`render::pilot::MAX_EXTENT_RATIO`), or its share of
-    /// the frame's shadow tests could not repay the build (`render::pilot::BUILD_TESTS_PER_TRIANGLE`).
+    /// the frame's shadow tests could not repay the build
+    /// (`render::pilot::BUILD_TESTS_PER_TRIANGLE`).
     pub light_buffers_skipped: usize,
     /// Shadow segments of the pilot frame (0 when there was no buffer to decide on).
     pub pilot_shadow_rays: usize,

@@ -13,8 +13,8 @@
 //! [`build_lights`] traces the pilot through the global BVH before building any buffer, and
 //! builds none for a light too wide next to its pilot segments ([`MAX_EXTENT_RATIO`]): such a
 //! buffer never paid, and costs the most to build; nor for a light whose share of the frame's
-//! shadow tests could not repay its buffer's build ([`BUILD_TESTS_PER_TRIANGLE`]). [`prune_by_pilot`] decides for a structure
-//! whose buffers are all built already.
+//! shadow tests could not repay its buffer's build ([`BUILD_TESTS_PER_TRIANGLE`]).
+//! [`prune_by_pilot`] decides for a structure whose buffers are all built already.
 
 use std::time::Instant;
 
@@ -92,10 +92,10 @@ fn decide(
 /// The `lights` structure built with the pilot frame deciding first: the global BVH, the pilot
 /// frame of `camera` (made at [`pilot_size`], `size`) traced through it, then a buffer built only
 /// for the light groups whose pilot segments leave it a chance to pay
-/// ([`MAX_EXTENT_RATIO`]) in a frame of `frame_samples` samples ([`repays_build`]), and of those
+/// ([`MAX_EXTENT_RATIO`]) in a frame of `frame_samples` samples ([`BUILD_TESTS_PER_TRIANGLE`]), and of those
 /// kept only the ones that need at most [`KEEP_RATIO`] of the global BVH's tests on the same
-/// segments. The pilot's segments do not depend on the
-/// structure (every structure answers alike), so one pilot serves both decisions.
+/// segments. The pilot's segments do not depend on the structure (every structure answers
+/// alike), so one pilot serves both decisions.
 pub fn build_lights(
     scene: &Scene,
     lights: &LightSet,

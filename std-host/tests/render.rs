@@ -343,7 +343,45 @@ fn bad_lights_cameras_and_scenes_are_one_line_errors() {
     assert!(err.contains("cannot read lights file"), "{err}");
     std::fs::write(&lights, "").unwrap();
     let err = error_of(&["render", "builtin:random100", "--lights", l, "--out", o]);
-    assert!(err.contains("has no light"), "{err}");
+    assert!(
+        err.contains("has no light") && err.contains("holds no [[light]]"),
+        "{err}"
+    );
+    let err = error_of(&["render", "builtin:random100", "--out", o]);
+    assert!(err.contains("no --lights file was given"), "{err}");
+    // A light whose power rounds to zero is dropped, and the error says so.
+    std::fs::write(
+        &lights,
+        "[[light]]\nkind = \"spot\"\nposition = [5, 9, 5]\ndirection = [0, -1, 0]\n\
+         angle_deg = 1e-30\nintensity = [1, 1, 1]\n",
+    )
+    .unwrap();
+    let err = error_of(&["render", "builtin:random100", "--lights", l, "--out", o]);
+    assert!(err.contains("no light of positive power"), "{err}");
+    // A light too bright for f32: no image, rather than an image of infinities.
+    std::fs::write(
+        &lights,
+        "[[light]]\nkind = \"point\"\nposition = [5, 5, 5]\nintensity = [3e38, 3e38, 3e38]\n",
+    )
+    .unwrap();
+    let err = error_of(&[
+        "render",
+        "builtin:room",
+        "--lights",
+        l,
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--spp",
+        "1",
+        "--out",
+        o,
+    ]);
+    assert!(err.contains("radiance overflows single precision"), "{err}");
+    assert!(!out.exists());
+    let err = error_of(&["render", "builtin:room", "--threads", "5000", "--out", o]);
+    assert!(err.contains("--threads"), "{err}");
     let err = error_of(&[
         "render",
         "builtin:room",
@@ -469,4 +507,100 @@ fn the_pilot_drops_a_buffer_that_does_not_pay() {
     let png = |n: &str| std::fs::read(dir.join(n)).unwrap();
     assert_eq!(png("global.png"), png("lights.png"));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A wall lit by an emissive quad over a small occluder, as OBJ text with every coordinate
+/// times `scale`.
+fn lit_wall(scale: f32) -> String {
+    let quads: [(&str, [[f32; 3]; 4]); 3] = [
+        (
+            "wall",
+            [
+                [-1.0, -1.0, 0.0],
+                [1.0, -1.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [-1.0, 1.0, 0.0],
+            ],
+        ),
+        (
+            "wall",
+            [
+                [-0.3, -0.3, 0.3],
+                [0.3, -0.3, 0.3],
+                [0.3, 0.3, 0.3],
+                [-0.3, 0.3, 0.3],
+            ],
+        ),
+        (
+            "light",
+            [
+                [-0.2, 0.6, 0.8],
+                [0.2, 0.6, 0.8],
+                [0.2, 0.9, 0.8],
+                [-0.2, 0.9, 0.8],
+            ],
+        ),
+    ];
+    let mut obj = String::from("mtllib lit_wall.mtl\n");
+    for (i, (material, corners)) in quads.iter().enumerate() {
+        obj += &format!("usemtl {material}\n");
+        for c in corners {
+            obj += &format!("v {} {} {}\n", c[0] * scale, c[1] * scale, c[2] * scale);
+        }
+        let k = 4 * i + 1;
+        obj += &format!("f {} {} {}\nf {} {} {}\n", k, k + 1, k + 2, k, k + 2, k + 3);
+    }
+    obj
+}
+
+/// Light, shading normals, the default camera and every offset are relative to the scene:
+/// the same scene at 2^-33 (about 1e-10) and 2^33 (about 1e10) units renders as at one unit.
+/// (Triangle normals and areas square the scale, which f32 holds only to about 1e19: past
+/// it, paths ended at every hit and lights' powers overflowed.)
+#[test]
+fn a_scene_renders_alike_at_any_scale_inside_the_documented_range() {
+    let dir = scratch("scale");
+    std::fs::write(
+        dir.join("lit_wall.mtl"),
+        "newmtl wall\nKd 0.8 0.8 0.8\nnewmtl light\nKd 0 0 0\nKe 20 20 20\n",
+    )
+    .unwrap();
+    let mut reports = Vec::new();
+    for (name, scale) in [
+        ("one", 1.0),
+        ("tiny", 2f32.powi(-33)),
+        ("huge", 2f32.powi(33)),
+    ] {
+        let obj = dir.join(format!("{name}.obj"));
+        std::fs::write(&obj, lit_wall(scale)).unwrap();
+        let png = dir.join(format!("{name}.png"));
+        let args = [
+            "--width",
+            "24",
+            "--height",
+            "24",
+            "--spp",
+            "2",
+            "--max-bounces",
+            "1",
+        ];
+        reports.push(render(&[obj.to_str().unwrap()], &png, &args));
+    }
+    let one = &reports[0];
+    assert!(one["mean_luminance"].as_f64().unwrap() > 0.01, "{one}");
+    for other in &reports[1..] {
+        for key in [
+            "camera_rays",
+            "shadow_rays",
+            "bounce_rays",
+            "shadow_occluded",
+        ] {
+            assert_eq!(one[key], other[key], "{key}: {other}");
+        }
+        let (a, b) = (
+            one["mean_luminance"].as_f64().unwrap(),
+            other["mean_luminance"].as_f64().unwrap(),
+        );
+        assert!((a - b).abs() <= 1e-5 * a, "{a} against {b}");
+    }
 }

@@ -48,9 +48,9 @@ pub struct RenderArgs {
     /// The seed of every random number: the image depends on it alone.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Worker threads (0: every core).
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
+    /// Worker threads (0: every core; at most 1024).
+    #[arg(long, default_value_t = 0, value_parser = value_parser!(u32).range(0..=1024))]
+    pub threads: u32,
     /// The camera's position [default: the scene's own view (builtin:room: inside, by the front
     /// wall), else in front of the scene's +z face, framing its bounds]
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
@@ -184,7 +184,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
         })?;
     }
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads)
+        .num_threads(args.threads as usize)
         .build()
         .map_err(|e| CliError::Usage(format!("cannot start {} threads: {e}", args.threads)))?;
     let report = pool.install(|| render(args))?;
@@ -201,11 +201,17 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
 pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
     let (scene, _) = load_scene(&args.scene, Some(&args.out))?;
     let mut lights = emissive_lights(&scene);
+    let emissive = lights.len();
+    let mut from_file = None;
     if let Some(path) = &args.lights {
-        lights.extend(read_lights(path)?);
+        let file = read_lights(path)?;
+        from_file = Some((path.display().to_string(), file.len()));
+        lights.extend(file);
     }
     let lights = LightSet::new(lights, &scene.triangles).ok_or_else(|| RenderError::NoLights {
         scene: scene.name.clone(),
+        emissive,
+        from_file,
     })?;
     let (eye, look_at) = match scene.view {
         Some(view) => (view.eye, view.look_at),
@@ -260,6 +266,10 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         progress: std::io::stderr().is_terminal(),
     };
     let frame = render_frame(&integrator, &camera, &settings);
+    let luminance = mean_luminance(&frame.pixels);
+    if !luminance.is_finite() {
+        return Err(RenderError::RadianceOverflow.into());
+    }
     let shadow_ms = replay_shadow_rays(
         &structure,
         &frame.shadow_rays,
@@ -306,7 +316,7 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         shadow_triangle_tests: c.shadow_triangle_tests,
         shadow_replay_rays: frame.shadow_rays.len(),
         shadow_ms,
-        mean_luminance: mean_luminance(&frame.pixels),
+        mean_luminance: luminance,
         out: args.out.display().to_string(),
     })
 }

@@ -4,6 +4,7 @@
 use rdbvh_core::geometry::{Aabb, Ray};
 use rdbvh_core::Vec3;
 
+use super::direction::{in_range, unit};
 use super::RenderError;
 
 /// The default vertical field of view, in degrees.
@@ -49,18 +50,12 @@ impl Camera {
                 "--eye {eye} and --look-at {look_at} are too far apart for single precision"
             ));
         }
-        // Squared, a view past 1.8e19 overflows f32 and would normalise to zero: such a view is
-        // scaled down first (others are not, so that their rays keep their bits).
-        let forward = if view.length_squared().is_finite() {
-            view.normalize_or_zero()
-        } else {
-            (view / view.abs().max_element()).normalize_or_zero()
-        };
-        if forward == Vec3::ZERO || !forward.is_finite() {
+        let forward = unit(view);
+        if forward == Vec3::ZERO {
             return bad("--eye and --look-at must differ".to_string());
         }
-        let right = forward.cross(up).normalize_or_zero();
-        if right == Vec3::ZERO || !right.is_finite() {
+        let right = unit(forward.cross(in_range(up)));
+        if right == Vec3::ZERO {
             return bad(format!(
                 "--up {up} must not be zero or parallel to the viewing direction"
             ));
@@ -94,18 +89,13 @@ impl Camera {
         let tan_y = (fov_deg.to_radians() * 0.5).tan();
         let aspect = width as f32 / height.max(1) as f32;
         let fit = (half.y / tan_y).max(half.x / (tan_y * aspect)) * 1.05;
-        // A scene flat in x and y (or a single point) still needs the eye off its face.
-        // `|half|`, scaled down first where its square overflows f32 (see `Camera::new`).
-        let largest = half.max_element();
-        let length = if half.length_squared().is_finite() {
-            half.length()
-        } else {
-            (half / largest).length() * largest
-        };
+        // A scene flat in x and y still needs the eye off its face: by a tenth of its depth. A
+        // single point at the world origin, by one unit. Every other distance is relative to
+        // the scene, whatever its scale.
         let distance = fit
-            .max(length * 0.1)
-            .max(1e-3 * centre.abs().max_element())
-            .max(1e-6);
+            .max(0.1 * half.max_element())
+            .max(1e-3 * centre.abs().max_element());
+        let distance = if distance > 0.0 { distance } else { 1.0 };
         let eye = Vec3::new(centre.x, centre.y, bounds.max.z + distance);
         if !eye.is_finite() || eye == centre {
             return Err(RenderError::Camera(format!(
@@ -175,6 +165,15 @@ mod tests {
         // A long view still has a direction.
         let c = Camera::new(Vec3::ZERO, Vec3::new(0.0, 0.0, 1e30), Vec3::Y, 45.0, 8, 8).unwrap();
         assert_eq!(c.forward, Vec3::Z);
+        // Huge and tiny vectors still have directions: only their directions matter.
+        for s in [1e20, 1e-30, 1e-44] {
+            let c = Camera::new(Vec3::ZERO, Vec3::Z * s, Vec3::Y * s, 45.0, 8, 8).unwrap();
+            assert_eq!(c.forward, Vec3::Z, "{s}");
+            assert!(c.right.normalize().abs_diff_eq(Vec3::NEG_X, 1e-6), "{s}");
+        }
+        // An up nearly along the view: its small perpendicular part gives the image's up.
+        let c = Camera::new(Vec3::ZERO, Vec3::Z, Vec3::new(0.0, 1e-25, 1.0), 45.0, 8, 8).unwrap();
+        assert!(c.right.normalize().abs_diff_eq(Vec3::NEG_X, 1e-6));
     }
 
     #[test]
@@ -185,6 +184,19 @@ mod tests {
             why.contains("default camera") && why.contains("--eye"),
             "{why}"
         );
+    }
+
+    /// The default camera frames a scene of any size, however small, and a single point.
+    #[test]
+    fn framing_is_relative_to_the_scene() {
+        for s in [1e-12, 1e-8, 1.0, 1e10] {
+            let b = Aabb::new(Vec3::splat(-s), Vec3::splat(s));
+            let c = Camera::framing(b, 50.0, 8, 8).unwrap();
+            let d = c.eye().z / s;
+            assert!(d > 2.0 && d < 4.0, "{s}: eye at {}", c.eye());
+        }
+        let point = Camera::framing(Aabb::new(Vec3::ZERO, Vec3::ZERO), 50.0, 8, 8).unwrap();
+        assert_eq!(point.eye(), Vec3::Z);
     }
 
     #[test]

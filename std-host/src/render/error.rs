@@ -48,7 +48,13 @@ pub enum RenderError {
     NoLights {
         /// The scene's name.
         scene: String,
+        /// Its emissive triangles.
+        emissive: usize,
+        /// The lights file given, and how many lights it holds.
+        from_file: Option<(String, usize)>,
     },
+    /// The image's radiance is not finite: the lights are too bright for f32.
+    RadianceOverflow,
     /// The camera cannot be made from the options given.
     Camera(String),
     /// The BVH or a light buffer could not be built.
@@ -82,10 +88,42 @@ impl fmt::Display for RenderError {
                 None => write!(f, "{}: light {index}: {reason}", path.display()),
             },
             RenderError::Material { name, reason } => write!(f, "material `{name}`: {reason}"),
-            RenderError::NoLights { scene } => write!(
+            RenderError::NoLights {
+                scene,
+                emissive: 0,
+                from_file: None,
+            } => write!(
                 f,
                 "{scene} has no light: no material emits (MTL `Ke`) and no --lights file was \
                  given"
+            ),
+            RenderError::NoLights {
+                scene,
+                emissive: 0,
+                from_file: Some((file, 0)),
+            } => write!(
+                f,
+                "{scene} has no light: no material emits (MTL `Ke`) and the lights file {file} \
+                 holds no [[light]]"
+            ),
+            RenderError::NoLights {
+                scene,
+                emissive,
+                from_file,
+            } => {
+                let given = from_file.as_ref().map_or(0, |(_, n)| *n);
+                write!(
+                    f,
+                    "{scene} has no light of positive power: {emissive} emissive triangles \
+                     (MTL `Ke`) and {given} lights from --lights, each emitting nothing in \
+                     single precision (a triangle too small, a spot's `angle_deg` or a quad's \
+                     area too small, or an emission that rounds to zero)"
+                )
+            }
+            RenderError::RadianceOverflow => write!(
+                f,
+                "the image's radiance overflows single precision: a light's `intensity` or \
+                 `radiance` (or an MTL `Ke`) is too large for this scene; no image was written"
             ),
             RenderError::Camera(why) => write!(f, "camera: {why}"),
             RenderError::Build(e) => write!(f, "BVH build failed: {e}"),

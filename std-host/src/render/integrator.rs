@@ -11,6 +11,7 @@ use rdbvh_core::bvh::{Hit, TraversalStats};
 use rdbvh_core::geometry::{Ray, Triangle};
 use rdbvh_core::{prefetch, Vec3};
 
+use super::direction::unit;
 use super::sampler::{vertex_dim, Sampler};
 use super::shadow_batch::{PathBatch, ShadowTests};
 use super::{LightSet, RenderError, Structure};
@@ -189,7 +190,8 @@ impl<'a> Integrator<'a> {
             // of the scene's triangle, which is not read: the block is in the caches, the
             // triangle array's entry usually is not.
             let p = t.v0 + t.e1 * hit.u + t.e2 * hit.v;
-            let mut n = t.e1.cross(t.e2).normalize_or_zero();
+            // `unit`: a triangle of edges past about 4e9 or below 3e-10 units still has a normal.
+            let mut n = unit(t.e1.cross(t.e2));
             if n == Vec3::ZERO {
                 break;
             }

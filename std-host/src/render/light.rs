@@ -1,8 +1,9 @@
 //! The renderer's lights and how next event estimation samples them: point, spot and quad lights
 //! from a lights file, and the scene's emissive triangles.
 
-use std::f32::consts::PI;
+use std::f64::consts::PI;
 
+use glam::DVec3;
 use rdbvh_core::geometry::Triangle;
 use rdbvh_core::light_buffer::{LightSource, LightSourceError};
 use rdbvh_core::Vec3;
@@ -74,23 +75,29 @@ pub fn luminance(c: Vec3) -> f32 {
 impl Light {
     /// The light's emitted power in luminance (watts, up to the unit of the file's numbers): the
     /// weight by which next event estimation chooses it. Point `4 pi I`, spot
-    /// `2 pi (1 - cos) I`, quad `pi A L`, emissive triangle `2 pi A L` (both faces).
-    pub fn power(&self, triangles: &[Triangle]) -> f32 {
+    /// `2 pi (1 - cos) I`, quad `pi A L`, emissive triangle `2 pi A L` (both faces). In f64,
+    /// where no finite light's power overflows (an area squares its coordinates' scale).
+    pub fn power(&self, triangles: &[Triangle]) -> f64 {
+        let luminance = |c: Vec3| f64::from(luminance(c));
+        // Twice the area of the triangle (a, a + e1, a + e2).
+        let parallelogram = |e1: DVec3, e2: DVec3| e1.cross(e2).length();
         match *self {
             Light::Point { intensity, .. } => 4.0 * PI * luminance(intensity),
             Light::Spot {
                 cos_half_angle,
                 intensity,
                 ..
-            } => 2.0 * PI * (1.0 - cos_half_angle) * luminance(intensity),
+            } => 2.0 * PI * (1.0 - f64::from(cos_half_angle)) * luminance(intensity),
             Light::Quad {
                 edge1,
                 edge2,
                 radiance,
                 ..
-            } => PI * edge1.cross(edge2).length() * luminance(radiance),
+            } => PI * parallelogram(edge1.as_dvec3(), edge2.as_dvec3()) * luminance(radiance),
             Light::Emissive { triangle, radiance } => {
-                2.0 * PI * triangles[triangle as usize].area() * luminance(radiance)
+                let t = &triangles[triangle as usize];
+                let (v0, v1, v2) = (t.v0.as_dvec3(), t.v1.as_dvec3(), t.v2.as_dvec3());
+                PI * parallelogram(v1 - v0, v2 - v0) * luminance(radiance)
             }
         }
     }
@@ -231,10 +238,7 @@ impl LightSet {
             .into_iter()
             .filter(|l| l.power(triangles) > 0.0)
             .collect();
-        let powers: Vec<f64> = lights
-            .iter()
-            .map(|l| f64::from(l.power(triangles)))
-            .collect();
+        let powers: Vec<f64> = lights.iter().map(|l| l.power(triangles)).collect();
         let total: f64 = powers.iter().sum();
         if !(total > 0.0 && total.is_finite()) {
             return None;

@@ -34,7 +34,7 @@ pub(super) struct Group {
     bounds: Aabb,
     /// The group's emissive material (none for a light from the lights file).
     material: Option<Vec3>,
-    pub(super) power: f32,
+    pub(super) power: f64,
     /// The light from the lights file, whose own source (cone, front) is kept.
     pub(super) single: Option<Light>,
 }

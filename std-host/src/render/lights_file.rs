@@ -27,6 +27,7 @@ use std::path::Path;
 use rdbvh_core::Vec3;
 use toml::{Table, Value};
 
+use super::direction::unit;
 use super::{Light, RenderError};
 
 /// The light kinds and the fields each one takes, all required.
@@ -135,7 +136,7 @@ fn parse_light(fields: &Table) -> Result<Light, (Option<&'static str>, String)> 
             let half_angle = (angle as f32).to_radians().min(std::f32::consts::FRAC_PI_2);
             Ok(Light::Spot {
                 position,
-                direction: direction.normalize(),
+                direction: unit(direction),
                 half_angle,
                 cos_half_angle: half_angle.cos(),
                 intensity: colour("intensity")?,
@@ -144,8 +145,18 @@ fn parse_light(fields: &Table) -> Result<Light, (Option<&'static str>, String)> 
         _ => {
             let corner = vector("corner")?;
             let (edge1, edge2) = (vector("edge1")?, vector("edge2")?);
-            let area = edge1.cross(edge2).length();
-            if !(area > 1e-6 * edge1.length() * edge2.length() && area > 0.0) {
+            // In f64, where neither the area nor the lengths' squares overflow or underflow.
+            let (e1, e2) = (edge1.as_dvec3(), edge2.as_dvec3());
+            let area = e1.cross(e2).length();
+            // The sample weight takes `edge1 x edge2` in f32.
+            if !edge1.cross(edge2).is_finite() {
+                return Err(fail(format!(
+                    "`edge1` {} and `edge2` {} span an area too large for single precision",
+                    show(edge1),
+                    show(edge2)
+                )));
+            }
+            if !(area > 1e-6 * e1.length() * e2.length() && area > 0.0) {
                 return Err(fail(format!(
                     "`edge1` {} and `edge2` {} span no area: the quad is degenerate",
                     show(edge1),
@@ -303,6 +314,11 @@ mod tests {
                  edge2 = [1, 0, 0]\nradiance = [1, 1, 1]\n",
                 "the quad is degenerate",
             ),
+            (
+                "[[light]]\nkind = \"quad\"\ncorner = [0, 0, 0]\nedge1 = [1e20, 0, 0]\n\
+                 edge2 = [0, 1e20, 0]\nradiance = [1, 1, 1]\n",
+                "span an area too large for single precision",
+            ),
             ("[[lights]]\nkind = \"point\"\n", "unknown key `lights`"),
             ("light = 3\n", "`light` must be an array of tables"),
             ("[[light]\n", "l.toml"),
@@ -334,5 +350,22 @@ mod tests {
         };
         assert_eq!(direction, Vec3::Y);
         assert!(half_angle <= std::f32::consts::FRAC_PI_2);
+    }
+
+    /// A spot's axis is a direction whatever its length: one whose square leaves f32's range
+    /// once normalised to zero or to NaN, and the spot lit nothing.
+    #[test]
+    fn a_spot_axis_of_any_finite_length_is_a_direction() {
+        for len in ["1e-30", "1e20", "3e38"] {
+            let lights = parse(&format!(
+                "[[light]]\nkind = \"spot\"\nposition = [0, 0, 0]\ndirection = [0, -{len}, 0]\n\
+                 angle_deg = 30\nintensity = [1, 1, 1]\n"
+            ))
+            .unwrap();
+            let Light::Spot { direction, .. } = lights[0] else {
+                panic!()
+            };
+            assert_eq!(direction, Vec3::NEG_Y, "{len}");
+        }
     }
 }

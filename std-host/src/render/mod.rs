@@ -27,6 +27,7 @@
 //!   [`replay_shadow_rays`] times the frame's shadow segments on one thread.
 
 mod camera;
+mod direction;
 mod error;
 mod frame;
 mod image;

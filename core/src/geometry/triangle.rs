@@ -92,10 +92,18 @@ impl Triangle {
         (self.v0 + self.v1 + self.v2) * (1.0 / 3.0)
     }
 
-    /// The triangle's area.
+    /// The triangle's area. Where the cross product's square leaves f32's normal range (edges
+    /// past about 4e9 or below 3e-10 units), its length is taken in f64, so the area is right
+    /// (or infinite past f32's range) instead of infinite or zero.
     #[inline]
     pub fn area(&self) -> f32 {
-        0.5 * (self.v1 - self.v0).cross(self.v2 - self.v0).length()
+        let c = (self.v1 - self.v0).cross(self.v2 - self.v0);
+        let squared = c.length_squared();
+        if squared.is_finite() && squared >= f32::MIN_POSITIVE {
+            0.5 * c.length()
+        } else {
+            (0.5 * c.as_dvec3().length()) as f32
+        }
     }
 
     /// True when every vertex coordinate is finite.
@@ -179,6 +187,17 @@ mod tests {
             Vec3::new(1.0, 0.0, 1.0),
             Vec3::new(0.0, 1.0, 1.0),
         )
+    }
+
+    /// Half a unit square at any scale f32 holds its area at: 2^-60 to 2^60 units a side.
+    #[test]
+    fn area_at_any_scale() {
+        assert_eq!(tri().area(), 0.5);
+        for k in [-60, -20, 20, 60] {
+            let s = 2f32.powi(k);
+            let t = Triangle::new(tri().v0 * s, tri().v1 * s, tri().v2 * s);
+            assert_eq!(t.area(), 0.5 * s * s, "2^{k}");
+        }
     }
 
     #[test]

@@ -555,8 +555,8 @@ fn lit_wall(scale: f32) -> String {
 
 /// Light, shading normals, the default camera and every offset are relative to the scene:
 /// the same scene at 2^-33 (about 1e-10) and 2^33 (about 1e10) units renders as at one unit.
-/// (Triangle normals and areas square the scale, which f32 holds only to about 1e19: past
-/// it, paths ended at every hit and lights' powers overflowed.)
+/// (A normal's and an area's length square the edges' cross product, about the fourth power
+/// of the scale: past about 4e9 units that overflowed f32, and paths ended at every hit.)
 #[test]
 fn a_scene_renders_alike_at_any_scale_inside_the_documented_range() {
     let dir = scratch("scale");

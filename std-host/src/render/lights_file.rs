@@ -145,9 +145,6 @@ fn parse_light(fields: &Table) -> Result<Light, (Option<&'static str>, String)> 
         _ => {
             let corner = vector("corner")?;
             let (edge1, edge2) = (vector("edge1")?, vector("edge2")?);
-            // In f64, where neither the area nor the lengths' squares overflow or underflow.
-            let (e1, e2) = (edge1.as_dvec3(), edge2.as_dvec3());
-            let area = e1.cross(e2).length();
             // The sample weight takes `edge1 x edge2` in f32.
             if !edge1.cross(edge2).is_finite() {
                 return Err(fail(format!(
@@ -156,6 +153,9 @@ fn parse_light(fields: &Table) -> Result<Light, (Option<&'static str>, String)> 
                     show(edge2)
                 )));
             }
+            // In f64, where neither the area nor the lengths' squares overflow or underflow.
+            let (e1, e2) = (edge1.as_dvec3(), edge2.as_dvec3());
+            let area = e1.cross(e2).length();
             if !(area > 1e-6 * e1.length() * e2.length() && area > 0.0) {
                 return Err(fail(format!(
                     "`edge1` {} and `edge2` {} span no area: the quad is degenerate",

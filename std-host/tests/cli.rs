@@ -1156,3 +1156,35 @@ fn trace_decides_far_rays_by_the_scene_not_the_origin() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Columns a rays file has beyond `ox..dz, tmin, tmax` are not read, and `trace` says so: a
+/// misspelt `t_max` would otherwise make every segment a whole ray without a word.
+#[test]
+fn trace_names_the_columns_it_does_not_read() {
+    let dir = scratch("columns");
+    let (rays, out) = (dir.join("rays.csv"), dir.join("hits.csv"));
+    let run = |header: &str| {
+        std::fs::write(&rays, format!("{header}\n0.5,0.5,-2,0,0,1,0.5,7\n")).unwrap();
+        let args = [
+            "trace",
+            "builtin:random100",
+            "--rays",
+            rays.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        let result = rdbvh(&args);
+        assert!(result.status.success(), "{}", text(&result.stderr));
+        text(&result.stderr)
+    };
+    let stderr = run("ox,oy,oz,dx,dy,dz,t_max,id");
+    for name in ["t_max", "id"] {
+        let line = format!("column '{name}' is not read");
+        assert!(
+            stderr.contains("warning: ") && stderr.contains(&line),
+            "{stderr}"
+        );
+    }
+    assert!(!run("ox,oy,oz,dx,dy,dz,tmin,tmax").contains("warning"));
+    std::fs::remove_dir_all(&dir).ok();
+}

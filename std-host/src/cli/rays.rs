@@ -218,6 +218,22 @@ fn parse_text(text: &[u8], label: &Path, piece: usize) -> Result<Vec<Ray>, RaysE
         tmin: column(OPTIONAL_COLUMNS[0])?,
         tmax: column(OPTIONAL_COLUMNS[1])?,
     };
+    // Other columns are allowed (an id, say) but said: a misspelt `t_max` would otherwise turn
+    // every segment into a whole ray without a word.
+    for name in header.iter().filter(|h| {
+        !h.is_empty()
+            && !REQUIRED_COLUMNS
+                .iter()
+                .chain(&OPTIONAL_COLUMNS)
+                .any(|c| h.eq_ignore_ascii_case(c))
+    }) {
+        eprintln!(
+            "warning: {}: column '{name}' is not read (rays take {}, optionally {})",
+            label.display(),
+            REQUIRED_COLUMNS.join(","),
+            OPTIONAL_COLUMNS.join(",")
+        );
+    }
     // Where the reader stands after the header (past any blank lines before it and its line end).
     let body = usize::try_from(csv.position().byte()).unwrap_or(usize::MAX);
     let pieces = match pieces(text, body, piece) {

@@ -33,7 +33,8 @@ pub struct TraceArgs {
     /// The scene: an OBJ file, or builtin:NAME for a built-in scene.
     #[arg(value_name = "SCENE.obj")]
     pub scene: String,
-    /// Rays, one per row: header `ox,oy,oz,dx,dy,dz`, optionally `tmin,tmax` (any order).
+    /// Rays, one per row: header `ox,oy,oz,dx,dy,dz`, optionally `tmin,tmax` (any order; other
+    /// columns are not read, with a warning).
     #[arg(long, value_name = "RAYS.csv")]
     pub rays: PathBuf,
     /// Where to write the answers: `ray,t,triangle,u,v` (closest hit, empty on a miss) or

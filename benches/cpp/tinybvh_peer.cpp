@@ -7,6 +7,8 @@
 
 #include <cstdint>
 #include <new>
+#include <utility>
+#include <vector>
 
 using tinybvh::bvhvec3;
 using tinybvh::bvhvec4;
@@ -33,6 +35,30 @@ void* build_layout(const float* verts, uint32_t tris, bool threaded, bool hq) {
         b->Build(v, tris);
     }
     return b;
+}
+
+// The most stack entries the layout's traversals (`Intersect`, `IsOccluded`: fixed arrays of
+// 256) can need on `m`: along a path from the root, each inner node leaves all its children but
+// the one it enters on the stack, and the traversal writes 8 entries at once where it pushes.
+// Counted on every child, hit or not, so it bounds every ray. Iterative: a degenerate tree can be
+// thousands of levels deep.
+template <int M>
+uint32_t stack_need(const tinybvh::MBVH<M>& m) {
+    if (m.usedNodes == 0) return 0;
+    std::vector<std::pair<uint32_t, uint32_t>> todo{{0, 0}};
+    uint32_t most = 0;
+    while (!todo.empty()) {
+        const auto [node, below] = todo.back();
+        todo.pop_back();
+        const auto& n = m.mbvhNode[node];
+        if (n.isLeaf()) continue;
+        uint32_t kids = 0;
+        for (int i = 0; i < M; i++) kids += n.child[i] != 0;
+        if (below + 8 > most) most = below + 8;
+        for (int i = 0; i < M; i++)
+            if (n.child[i]) todo.push_back({n.child[i], below + kids - 1});
+    }
+    return most;
 }
 
 template <typename B>
@@ -74,6 +100,10 @@ float rdbvh_tinybvh8_closest(const void* b, const void* ray) {
 bool rdbvh_tinybvh8_occluded(const void* b, const void* ray) {
     return occluded<tinybvh::BVH8_CPU>(b, static_cast<const tinybvh::Ray*>(ray));
 }
+// The traversal stack entries the tree can need (see `stack_need`); tinybvh's hold 256.
+uint32_t rdbvh_tinybvh8_stack_need(const void* b) {
+    return stack_need(static_cast<const tinybvh::BVH8_CPU*>(b)->bvh8);
+}
 
 void* rdbvh_tinybvh4_build(const float* verts, uint32_t tris, bool threaded, bool hq) {
     return build_layout<tinybvh::BVH4_CPU>(verts, tris, threaded, hq);
@@ -84,6 +114,9 @@ float rdbvh_tinybvh4_closest(const void* b, const void* ray) {
 }
 bool rdbvh_tinybvh4_occluded(const void* b, const void* ray) {
     return occluded<tinybvh::BVH4_CPU>(b, static_cast<const tinybvh::Ray*>(ray));
+}
+uint32_t rdbvh_tinybvh4_stack_need(const void* b) {
+    return stack_need(static_cast<const tinybvh::BVH4_CPU*>(b)->bvh4);
 }
 
 }  // extern "C"

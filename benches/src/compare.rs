@@ -23,6 +23,14 @@
 //! (`Mtris/s` or `Mrays/s`). obvhs is measured twice (its binary tree and its 8-wide compressed
 //! tree); under `obvhs`, builds report its binary-tree build (its fastest) and each traversal
 //! reports the faster of the two trees, which the text output names.
+//!
+//! **Peers that cannot be measured.** A peer is left out of a run, with no lines, a `-` in the
+//! text table and a `warning: left out: NAME: why` on stderr, when its answers disagree with
+//! rdbvh's and brute force, re-tracing up to 32 of the rays in question, gives rdbvh's answers;
+//! when its tree would overrun its traversal's fixed stack (tinybvh on degenerate builds); or when
+//! it panics. rdbvh's own adapters are never left out: their disagreement, or brute force
+//! contradicting rdbvh, stops the run with an error. A measure over an empty ray set (no shadow
+//! segments where no camera ray hits a surface facing the light) has no lines either.
 
 use std::fmt::Write as _;
 use std::time::{Duration, Instant};
@@ -306,10 +314,15 @@ pub struct Report {
     pub load: [String; 2],
     /// Per adapter.
     pub runs: Vec<LibraryRun>,
-    /// The reported numbers, [`LIBRARIES`] x [`Measure::ALL`].
+    /// The reported numbers, [`LIBRARIES`] x [`Measure::ALL`], but for libraries left out and
+    /// measures over an empty ray set.
     pub rows: Vec<Row>,
+    /// The peers' adapters left out, and why.
+    pub left_out: Vec<(&'static str, String)>,
     /// PAH against SAH, when measured.
     pub pah: Option<PahBuilds>,
+    /// Why PAH against SAH was asked for and not measured.
+    pub pah_error: Option<String>,
     /// rdbvh's top of the threaded build run on one thread (`Builder::build_top`, loading the
     /// arena included) and its whole single-threaded build, CPU seconds. The threaded build
     /// loads and bins its large top nodes on all threads, so this share bounds its serial part
@@ -387,37 +400,117 @@ where
     }
 }
 
-/// An adapter's trees (threaded and one-thread) checked against `sets`' reference answers, and
-/// the adapter ready to be timed.
-fn check<L: Library>(
+/// A ray set: its kind, its rays, and rdbvh's answers on them (the reference).
+type RaySet = (RayKind, Vec<Ray>, Answers);
+
+/// Why an adapter is not measured.
+enum Failure {
+    /// rdbvh is wrong (one of its adapters disagrees, or brute force contradicts its answers):
+    /// the run stops.
+    Fatal(String),
+    /// A peer cannot be measured on this scene (wrong answers, a tree its traversal cannot
+    /// take, a panic); the others are.
+    LeftOut(String),
+}
+
+/// Rays of a disagreement that brute force re-traces to tell who is wrong.
+const ARBITRATED: usize = 32;
+
+/// Brute force on up to [`ARBITRATED`] of the rays where a peer's answers differ from rdbvh's:
+/// the first ray on which rdbvh's answer is not brute force's (the same triangle test, so the
+/// same bits), if any.
+fn arbitrate(
     tris: &[Triangle],
-    sets: &[(RayKind, Vec<Ray>, Answers)],
-    one: &rayon::ThreadPool,
-    all: &rayon::ThreadPool,
-) -> Result<Contender<L>, String>
+    rays: &[Ray],
+    reference: &Answers,
+    peer: &Answers,
+) -> Result<usize, String> {
+    let rays_checked = crate::disagreements(reference, peer);
+    for &i in rays_checked.iter().take(ARBITRATED) {
+        let closest = rdbvh_core::brute_force::closest_hit(&rays[i], tris).map(|h| h.t);
+        let any = rdbvh_core::brute_force::any_hit(&rays[i], tris);
+        if closest != reference.closest[i] || any != reference.any[i] {
+            return Err(format!(
+                "ray {i} ({:?}): rdbvh answers closest {:?}, any {}; brute force {closest:?}, \
+                 {any}",
+                rays[i], reference.closest[i], reference.any[i]
+            ));
+        }
+    }
+    Ok(rays_checked.len().min(ARBITRATED))
+}
+
+/// A peer left out measures nothing.
+impl<L: Library> Reps for Option<Contender<L>>
 where
     L::Scene: Send,
     L::Accel: Send,
 {
-    let agree = |prepared: &Prepared<L>, which: &str| -> Result<[Agreement; 3], String> {
+    fn count(&self) -> usize {
+        Measure::ALL.len()
+    }
+
+    fn rep(
+        &mut self,
+        k: usize,
+        one: &rayon::ThreadPool,
+        all: &rayon::ThreadPool,
+    ) -> Option<(f64, f64)> {
+        self.as_mut()?.rep(k, one, all)
+    }
+}
+
+/// An adapter's trees (threaded and one-thread) checked against `sets`' reference answers, and
+/// the adapter ready to be timed. A peer whose answers disagree is left out once brute force
+/// confirms rdbvh's answers; rdbvh's own adapters must agree.
+fn check<L: Library>(
+    tris: &[Triangle],
+    sets: &[RaySet],
+    one: &rayon::ThreadPool,
+    all: &rayon::ThreadPool,
+) -> Result<Contender<L>, Failure>
+where
+    L::Scene: Send,
+    L::Accel: Send,
+{
+    let own = L::NAME.starts_with("rdbvh");
+    let agree = |prepared: &Prepared<L>, which: &str| -> Result<[Agreement; 3], Failure> {
+        if let Some(why) = L::unusable(&prepared.accel) {
+            return Err(Failure::LeftOut(format!("{which} build: {why}")));
+        }
         let mut out = [Agreement {
             rays: 0,
             closest: 1.0,
             any: 1.0,
         }; 3];
         for (slot, (kind, rays, reference)) in out.iter_mut().zip(sets) {
-            let g = agreement(reference, &prepared.answers(&L::rays(rays)));
+            let answers = prepared.answers(&L::rays(rays));
+            let g = agreement(reference, &answers);
             if g.closest < MIN_AGREEMENT || g.any < MIN_AGREEMENT {
-                return Err(format!(
-                    "{} ({which} build) disagrees with rdbvh on the {} rays: closest hit {:.4}%, \
-                     any hit {:.4}% of {} rays (at least {}% required)",
-                    L::NAME,
+                let what = format!(
+                    "{which} build disagrees with rdbvh on the {} rays: closest hit {:.4}%, any \
+                     hit {:.4}% of {} rays (at least {}% required)",
                     kind.name(),
                     100.0 * g.closest,
                     100.0 * g.any,
                     g.rays,
                     100.0 * MIN_AGREEMENT
-                ));
+                );
+                if own {
+                    return Err(Failure::Fatal(what));
+                }
+                return match arbitrate(tris, rays, reference, &answers) {
+                    Ok(checked) => Err(Failure::LeftOut(format!(
+                        "{what}; brute force gives rdbvh's answers on the {checked} of them \
+                         checked"
+                    ))),
+                    Err(e) => Err(Failure::Fatal(format!(
+                        "rdbvh disagrees with brute force on the {} rays, found where {} {what}: \
+                         {e}",
+                        kind.name(),
+                        L::NAME
+                    ))),
+                };
             }
             *slot = g;
         }
@@ -444,6 +537,59 @@ where
         agreement: agreement_1t,
         agreement_mt,
     })
+}
+
+/// rdbvh's own adapter, checked: any failure stops the run.
+fn own<L: Library>(
+    tris: &[Triangle],
+    sets: &[RaySet],
+    one: &rayon::ThreadPool,
+    all: &rayon::ThreadPool,
+) -> Result<Contender<L>, String>
+where
+    L::Scene: Send,
+    L::Accel: Send,
+{
+    check::<L>(tris, sets, one, all).map_err(|f| match f {
+        Failure::Fatal(e) | Failure::LeftOut(e) => format!("{}: {e}", L::NAME),
+    })
+}
+
+/// A peer, checked: `None` when it is left out (its name and why pushed on `left_out`), an
+/// error when checking it showed rdbvh wrong. A panic in the peer's build or queries leaves it
+/// out too (the panic message is kept, the default hook's report silenced meanwhile).
+fn peer<L: Library>(
+    tris: &[Triangle],
+    sets: &[RaySet],
+    one: &rayon::ThreadPool,
+    all: &rayon::ThreadPool,
+    left_out: &mut Vec<(&'static str, String)>,
+) -> Result<Option<Contender<L>>, String>
+where
+    L::Scene: Send,
+    L::Accel: Send,
+{
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let checked = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        check::<L>(tris, sets, one, all)
+    }));
+    std::panic::set_hook(hook);
+    let why = match checked {
+        Ok(Ok(c)) => return Ok(Some(c)),
+        Ok(Err(Failure::Fatal(e))) => return Err(e),
+        Ok(Err(Failure::LeftOut(why))) => why,
+        Err(payload) => {
+            let message = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "no message".into());
+            format!("it panicked: {message}")
+        }
+    };
+    left_out.push((L::NAME, why));
+    Ok(None)
 }
 
 /// A plane area over `b`: a light rectangle on top of the box (largest y), rays straight down,
@@ -548,28 +694,28 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         .map_err(|e| format!("cannot start the rayon pool: {e}"))?;
     let b = bounds(tris);
     let reference = Prepared::<Rdbvh>::new(tris);
-    let sets: Vec<(RayKind, Vec<Ray>, Answers)> =
-        [RayKind::Camera, RayKind::Random, RayKind::Shadow]
-            .into_iter()
-            .map(|kind| {
-                let rays = ray_set(tris, &b, kind);
-                let answers = reference.answers(&rays);
-                (kind, rays, answers)
-            })
-            .collect();
+    let sets: Vec<RaySet> = [RayKind::Camera, RayKind::Random, RayKind::Shadow]
+        .into_iter()
+        .map(|kind| {
+            let rays = ray_set(tris, &b, kind);
+            let answers = reference.answers(&rays);
+            (kind, rays, answers)
+        })
+        .collect();
     drop(reference);
     let share = |a: &Answers| {
         a.closest.iter().filter(|t| t.is_some()).count() as f64 / a.closest.len().max(1) as f64
     };
     // Every tree checked first, then every number measured in interleaved rounds.
-    let mut rdbvh = check::<Rdbvh>(tris, &sets, &one, &all)?;
-    let mut wide = check::<RdbvhWide>(tris, &sets, &one, &all)?;
-    let mut wide8 = check::<RdbvhWide8>(tris, &sets, &one, &all)?;
-    let mut bvh2 = check::<ObvhsBvh2>(tris, &sets, &one, &all)?;
-    let mut cwbvh = check::<ObvhsCwbvh>(tris, &sets, &one, &all)?;
-    let mut bvh = check::<BvhCrate>(tris, &sets, &one, &all)?;
-    let mut parry = check::<Parry>(tris, &sets, &one, &all)?;
-    let mut wide8_sbvh = check::<crate::peers::RdbvhWide8Sbvh>(tris, &sets, &one, &all)?;
+    let mut left_out = Vec::new();
+    let mut rdbvh = own::<Rdbvh>(tris, &sets, &one, &all)?;
+    let mut wide = own::<RdbvhWide>(tris, &sets, &one, &all)?;
+    let mut wide8 = own::<RdbvhWide8>(tris, &sets, &one, &all)?;
+    let mut bvh2 = peer::<ObvhsBvh2>(tris, &sets, &one, &all, &mut left_out)?;
+    let mut cwbvh = peer::<ObvhsCwbvh>(tris, &sets, &one, &all, &mut left_out)?;
+    let mut bvh = peer::<BvhCrate>(tris, &sets, &one, &all, &mut left_out)?;
+    let mut parry = peer::<Parry>(tris, &sets, &one, &all, &mut left_out)?;
+    let mut wide8_sbvh = own::<crate::peers::RdbvhWide8Sbvh>(tris, &sets, &one, &all)?;
     #[cfg(feature = "cpp-peers")]
     let (mut embree, mut tiny8, mut tiny4, mut embree_high, mut tiny8_hq) = {
         crate::peers::embree::available()?;
@@ -580,19 +726,22 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
                 tris.len()
             ));
         }
+        let l = &mut left_out;
         (
-            check::<crate::peers::Embree>(tris, &sets, &one, &all)?,
-            check::<crate::peers::TinybvhBvh8>(tris, &sets, &one, &all)?,
-            check::<crate::peers::TinybvhBvh4>(tris, &sets, &one, &all)?,
-            check::<crate::peers::EmbreeHigh>(tris, &sets, &one, &all)?,
-            check::<crate::peers::TinybvhBvh8Hq>(tris, &sets, &one, &all)?,
+            peer::<crate::peers::Embree>(tris, &sets, &one, &all, l)?,
+            peer::<crate::peers::TinybvhBvh8>(tris, &sets, &one, &all, l)?,
+            peer::<crate::peers::TinybvhBvh4>(tris, &sets, &one, &all, l)?,
+            peer::<crate::peers::EmbreeHigh>(tris, &sets, &one, &all, l)?,
+            peer::<crate::peers::TinybvhBvh8Hq>(tris, &sets, &one, &all, l)?,
         )
     };
     let mut top = SerialTop::new(tris, all.current_num_threads());
-    let mut pah_reps = if opts.pah {
-        Some(PahReps::new(tris, &b)?)
-    } else {
-        None
+    // Its influence areas span the scene; where they cannot (a scene whose extent overflows
+    // single precision's squares) the PAH builds go unmeasured, and the rest is still reported.
+    let (mut pah_reps, pah_error) = match opts.pah.then(|| PahReps::new(tris, &b)) {
+        Some(Ok(p)) => (Some(p), None),
+        Some(Err(e)) => (None, Some(e)),
+        None => (None, None),
     };
     let mut entries: Vec<&mut dyn Reps> = vec![
         &mut rdbvh,
@@ -620,23 +769,30 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
     }
     let t = interleave(&mut entries, opts, &one, &all);
     #[allow(unused_mut)]
-    let mut runs = vec![
-        rdbvh.run(&t[0]),
-        wide.run(&t[1]),
-        wide8.run(&t[2]),
-        bvh2.run(&t[3]),
-        cwbvh.run(&t[4]),
-        bvh.run(&t[5]),
-        parry.run(&t[6]),
-    ];
+    let mut runs: Vec<LibraryRun> = vec![
+        Some(rdbvh.run(&t[0])),
+        Some(wide.run(&t[1])),
+        Some(wide8.run(&t[2])),
+        bvh2.as_ref().map(|c| c.run(&t[3])),
+        cwbvh.as_ref().map(|c| c.run(&t[4])),
+        bvh.as_ref().map(|c| c.run(&t[5])),
+        parry.as_ref().map(|c| c.run(&t[6])),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
     #[cfg(feature = "cpp-peers")]
-    runs.extend([
-        embree.run(&t[9]),
-        tiny8.run(&t[10]),
-        tiny4.run(&t[11]),
-        embree_high.run(&t[12]),
-        tiny8_hq.run(&t[13]),
-    ]);
+    runs.extend(
+        [
+            embree.as_ref().map(|c| c.run(&t[9])),
+            tiny8.as_ref().map(|c| c.run(&t[10])),
+            tiny4.as_ref().map(|c| c.run(&t[11])),
+            embree_high.as_ref().map(|c| c.run(&t[12])),
+            tiny8_hq.as_ref().map(|c| c.run(&t[13])),
+        ]
+        .into_iter()
+        .flatten(),
+    );
     // Last, so the lines of the libraries before it keep their order.
     runs.push(wide8_sbvh.run(&t[8]));
     let serial_top = (t[7][0], t[7][1]);
@@ -661,7 +817,9 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         load: [load_before, load_average()],
         runs,
         rows,
+        left_out,
         pah,
+        pah_error,
         serial_top,
     })
 }
@@ -737,45 +895,56 @@ fn rate(count: usize, t: &Timing, measure: Measure, clock: Clock) -> f64 {
 /// its traversals the faster tree's.
 fn fold_rows(runs: &[LibraryRun], tris: usize, rays: [usize; 3], clock: Clock) -> Vec<Row> {
     let [camera, random, shadow] = rays;
-    let value = |run: &LibraryRun, m: Measure| {
-        let (i, count) = match m {
-            Measure::Build1t => (0, tris),
-            Measure::BuildMt => (1, tris),
-            Measure::ClosestCamera => (2, camera),
-            Measure::ClosestRandom => (3, random),
-            Measure::AnyRandom => (4, random),
-            Measure::AnyShadow => (5, shadow),
-        };
-        rate(count, &run.timings[i], m, clock)
+    let count = |m: Measure| match m {
+        Measure::Build1t | Measure::BuildMt => tris,
+        Measure::ClosestCamera => camera,
+        Measure::ClosestRandom | Measure::AnyRandom => random,
+        Measure::AnyShadow => shadow,
     };
-    let find = |name: &str| runs.iter().find(|r| r.name == name).expect("measured");
-    // The faster of two adapters of one library; `first_builds`: builds are the first's.
-    let faster = |first: &str, second: &str, m: Measure, first_builds: bool| {
-        let (x, y) = (find(first), find(second));
-        let (a, b) = (value(x, m), value(y, m));
-        if (first_builds && m.is_build()) || a >= b {
-            (x.name, a)
-        } else {
-            (y.name, b)
+    // Timings are in `Measure::ALL` order.
+    let value = |run: &LibraryRun, m: Measure| {
+        let i = Measure::ALL
+            .iter()
+            .position(|&x| x == m)
+            .expect("a measure");
+        rate(count(m), &run.timings[i], m, clock)
+    };
+    let find = |name: &str| runs.iter().find(|r| r.name == name);
+    // The faster of two adapters of one library (either may be left out); `first_builds`:
+    // builds are the first's while it is measured.
+    let faster = |first: &str, second: &str, m: Measure, first_builds: bool| match (
+        find(first),
+        find(second),
+    ) {
+        (Some(x), Some(y)) => {
+            let (a, b) = (value(x, m), value(y, m));
+            Some(if (first_builds && m.is_build()) || a >= b {
+                (x.name, a)
+            } else {
+                (y.name, b)
+            })
         }
+        (Some(r), None) | (None, Some(r)) => Some((r.name, value(r, m))),
+        (None, None) => None,
     };
     let mut rows = Vec::new();
     for &library in LIBRARIES {
-        for m in Measure::ALL {
-            let (source, v) = match library {
+        // A rate over no rays is no number: no line (a scene that no camera ray hits has no
+        // shadow segments).
+        for m in Measure::ALL.into_iter().filter(|&m| count(m) > 0) {
+            let row = match library {
                 "obvhs" => faster("obvhs-bvh2", "obvhs-cwbvh", m, true),
                 "tinybvh" => faster("tinybvh-bvh8", "tinybvh-bvh4", m, false),
-                _ => {
-                    let r = find(library);
-                    (r.name, value(r, m))
-                }
+                _ => find(library).map(|r| (r.name, value(r, m))),
             };
-            rows.push(Row {
-                library,
-                measure: m,
-                value: v,
-                source,
-            });
+            if let Some((source, v)) = row {
+                rows.push(Row {
+                    library,
+                    measure: m,
+                    value: v,
+                    source,
+                });
+            }
         }
     }
     rows
@@ -803,6 +972,14 @@ impl Report {
                     r.measure.unit()
                 )
             })
+            .collect()
+    }
+
+    /// One line per adapter left out: its name and why (`-` in the text table, no JSON lines).
+    pub fn left_out_lines(&self) -> Vec<String> {
+        self.left_out
+            .iter()
+            .map(|(name, why)| format!("left out: {name}: {why}"))
             .collect()
     }
 
@@ -867,18 +1044,26 @@ impl Report {
         for &library in LIBRARIES {
             let _ = write!(w, "{library:<11}");
             for m in Measure::ALL {
-                let v = self.value(library, m).unwrap_or(0.0);
                 let base = self.value("rdbvh", m).unwrap_or(0.0);
-                let cell = if library == "rdbvh" {
-                    format!("{v:.2}")
-                } else {
-                    format!("{v:.2} ({:.2}x)", v / base.max(1e-12))
+                let cell = match self.value(library, m) {
+                    None => "-".to_string(),
+                    Some(v) if library == "rdbvh" => format!("{v:.2}"),
+                    Some(v) => format!("{v:.2} ({:.2}x)", v / base.max(1e-12)),
                 };
                 let _ = write!(w, " {cell:>24}");
             }
             let _ = writeln!(w);
         }
         let _ = writeln!(w);
+        for line in self.left_out_lines() {
+            let _ = writeln!(w, "{line}");
+        }
+        if self.rays[2] == 0 {
+            let _ = writeln!(
+                w,
+                "any_shadow: no shadow segments (no camera ray hits a surface facing the light)"
+            );
+        }
         let obvhs: Vec<String> = self
             .rows
             .iter()
@@ -959,6 +1144,10 @@ impl Report {
                 cell(&r.agreement_mt[2]),
             );
         }
+        if let Some(e) = &self.pah_error {
+            let _ = writeln!(w);
+            let _ = writeln!(w, "PAH vs SAH: not measured: {e}");
+        }
         if let Some(p) = &self.pah {
             let m = |t: &Timing| rate(self.triangles, t, Measure::Build1t, self.clock);
             let sah = m(&p.sah);
@@ -1032,6 +1221,12 @@ pub fn main_with(args: impl IntoIterator<Item = String>, opts: Options) -> Resul
         ..opts
     };
     let report = run(&args.scene, &scene.triangles, &opts)?;
+    if args.json {
+        // The JSON lines name only what was measured; say on stderr what was not.
+        for line in report.left_out_lines() {
+            eprintln!("warning: {line}");
+        }
+    }
     Ok(if args.json {
         let mut s = report.json_lines().join("\n");
         s.push('\n');
@@ -1039,4 +1234,216 @@ pub fn main_with(args: impl IntoIterator<Item = String>, opts: Options) -> Resul
     } else {
         report.text()
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A peer that finds nothing: wrong on every ray that hits.
+    struct Blind;
+
+    impl Library for Blind {
+        const NAME: &'static str = "blind";
+        const PARALLEL_BUILD: Option<&'static str> = None;
+        type Scene = ();
+        type Ray = ();
+        type Accel = ();
+        fn scene(_: &[Triangle]) {}
+        fn rays(rays: &[Ray]) -> Vec<()> {
+            vec![(); rays.len()]
+        }
+        fn build(_: &mut ()) {}
+        fn closest(_: &(), _: &(), _: &()) -> Option<f32> {
+            None
+        }
+        fn any(_: &(), _: &(), _: &()) -> bool {
+            false
+        }
+    }
+
+    /// [`Blind`] under one of rdbvh's names: its disagreement is rdbvh's own.
+    struct OwnBlind;
+
+    impl Library for OwnBlind {
+        const NAME: &'static str = "rdbvh-blind";
+        const PARALLEL_BUILD: Option<&'static str> = None;
+        type Scene = ();
+        type Ray = ();
+        type Accel = ();
+        fn scene(_: &[Triangle]) {}
+        fn rays(rays: &[Ray]) -> Vec<()> {
+            Blind::rays(rays)
+        }
+        fn build(_: &mut ()) {}
+        fn closest(_: &(), _: &(), _: &()) -> Option<f32> {
+            None
+        }
+        fn any(_: &(), _: &(), _: &()) -> bool {
+            false
+        }
+    }
+
+    /// A peer whose build panics.
+    struct Panics;
+
+    impl Library for Panics {
+        const NAME: &'static str = "panics";
+        const PARALLEL_BUILD: Option<&'static str> = None;
+        type Scene = ();
+        type Ray = ();
+        type Accel = ();
+        fn scene(_: &[Triangle]) {}
+        fn rays(rays: &[Ray]) -> Vec<()> {
+            Blind::rays(rays)
+        }
+        fn build(_: &mut ()) {
+            panic!("a peer's own assertion");
+        }
+        fn closest(_: &(), _: &(), _: &()) -> Option<f32> {
+            None
+        }
+        fn any(_: &(), _: &(), _: &()) -> bool {
+            false
+        }
+    }
+
+    /// rdbvh's answers, from a tree that its traversal could not take.
+    struct Refused;
+
+    impl Library for Refused {
+        const NAME: &'static str = "refused";
+        const PARALLEL_BUILD: Option<&'static str> = None;
+        type Scene = Vec<Triangle>;
+        type Ray = Ray;
+        type Accel = Bvh;
+        fn scene(tris: &[Triangle]) -> Vec<Triangle> {
+            tris.to_vec()
+        }
+        fn rays(rays: &[Ray]) -> Vec<Ray> {
+            rays.to_vec()
+        }
+        fn build(tris: &mut Vec<Triangle>) -> Bvh {
+            Builder::sah().build(tris).expect("a scene")
+        }
+        fn unusable(_: &Bvh) -> Option<String> {
+            Some("too deep".into())
+        }
+        fn closest(bvh: &Bvh, tris: &Vec<Triangle>, ray: &Ray) -> Option<f32> {
+            bvh.closest_hit(ray, tris).map(|h| h.t)
+        }
+        fn any(bvh: &Bvh, tris: &Vec<Triangle>, ray: &Ray) -> bool {
+            bvh.any_hit(ray, tris)
+        }
+    }
+
+    fn scene() -> (Vec<Triangle>, Vec<RaySet>) {
+        let tris = rdbvh::scene::Scene::open("builtin:random1000")
+            .expect("built in")
+            .triangles;
+        let b = bounds(&tris);
+        let reference = Prepared::<Rdbvh>::new(&tris);
+        let sets = [RayKind::Camera, RayKind::Random, RayKind::Shadow]
+            .into_iter()
+            .map(|kind| {
+                let rays = ray_set(&tris, &b, kind);
+                let answers = reference.answers(&rays);
+                (kind, rays, answers)
+            })
+            .collect();
+        (tris, sets)
+    }
+
+    #[test]
+    fn a_peer_that_cannot_be_measured_is_left_out_and_says_why() {
+        let (tris, sets) = scene();
+        let (one, all) = (single_thread_pool(), single_thread_pool());
+        let mut left_out = Vec::new();
+        assert!(peer::<Blind>(&tris, &sets, &one, &all, &mut left_out)
+            .expect("rdbvh is right")
+            .is_none());
+        assert!(peer::<Panics>(&tris, &sets, &one, &all, &mut left_out)
+            .expect("a panic is the peer's")
+            .is_none());
+        assert!(peer::<Refused>(&tris, &sets, &one, &all, &mut left_out)
+            .expect("refused")
+            .is_none());
+        let names: Vec<&str> = left_out.iter().map(|(n, _)| *n).collect();
+        assert_eq!(names, ["blind", "panics", "refused"]);
+        assert!(
+            left_out[0]
+                .1
+                .contains("brute force gives rdbvh's answers on the 32 of them checked"),
+            "{}",
+            left_out[0].1
+        );
+        assert_eq!(left_out[1].1, "it panicked: a peer's own assertion");
+        assert_eq!(left_out[2].1, "threaded build: too deep");
+        // The same failure in one of rdbvh's own adapters stops the run.
+        let e = own::<OwnBlind>(&tris, &sets, &one, &all)
+            .err()
+            .expect("an error");
+        assert!(
+            e.starts_with("rdbvh-blind: threaded build disagrees with rdbvh on the camera rays"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn brute_force_decides_who_is_wrong() {
+        let (tris, sets) = scene();
+        let (_, rays, reference) = &sets[1];
+        let blind = Answers {
+            closest: vec![None; rays.len()],
+            any: vec![false; rays.len()],
+        };
+        let wrong = crate::disagreements(reference, &blind);
+        assert!(wrong.len() > ARBITRATED, "{}", wrong.len());
+        assert_eq!(arbitrate(&tris, rays, reference, &blind), Ok(ARBITRATED));
+        // Were rdbvh the one that misses, brute force says so, on the first ray it checks.
+        let e = arbitrate(&tris, rays, &blind, reference).expect_err("rdbvh wrong");
+        assert!(e.starts_with(&format!("ray {} (", wrong[0])), "{e}");
+    }
+
+    #[test]
+    fn rows_skip_what_was_left_out_and_empty_ray_sets() {
+        let timing = Timing {
+            cpu: 0.5,
+            wall: 1.0,
+            reps: 1,
+        };
+        let run = |name: &'static str| LibraryRun {
+            name,
+            parallel_build: None,
+            timings: [timing; 6],
+            agreement: [Agreement {
+                rays: 1,
+                closest: 1.0,
+                any: 1.0,
+            }; 3],
+            agreement_mt: [Agreement {
+                rays: 1,
+                closest: 1.0,
+                any: 1.0,
+            }; 3],
+        };
+        // obvhs measured by its compressed tree only; `bvh` left out; no shadow segments.
+        let runs = [run("rdbvh"), run("obvhs-cwbvh")];
+        let rows = fold_rows(&runs, 1000, [100, 100, 0], Clock::ThreadCpu);
+        let measured: Vec<Measure> = Measure::ALL
+            .into_iter()
+            .filter(|&m| m != Measure::AnyShadow)
+            .collect();
+        let of = |library: &str| -> Vec<(Measure, &str)> {
+            rows.iter()
+                .filter(|r| r.library == library)
+                .map(|r| (r.measure, r.source))
+                .collect()
+        };
+        let expect = |source| measured.iter().map(|&m| (m, source)).collect::<Vec<_>>();
+        assert_eq!(of("rdbvh"), expect("rdbvh"));
+        assert_eq!(of("obvhs"), expect("obvhs-cwbvh"));
+        assert!(of("bvh").is_empty());
+        assert_eq!(rows.len(), 2 * measured.len());
+    }
 }

@@ -206,8 +206,14 @@ pub fn pinhole_rays(eye: Vec3, forward: Vec3, half: f32, side: u32) -> Vec<Ray> 
 }
 
 /// `n` rays with origins uniform in `b` and directions uniform on the unit sphere, from `seed`.
+/// An axis of `b` thinner than 1e-3 of its widest is widened to that about its centre: in a flat
+/// scene's box every origin would lie on the geometry's plane, and each ray would measure only
+/// the libraries' rules for a hit at distance zero.
 pub fn random_rays(b: &Aabb, n: usize, seed: u64) -> Vec<Ray> {
     let mut rng = SplitMix64::new(seed);
+    let thinnest = 1e-3 * (b.max - b.min).max_element();
+    let pad = (Vec3::splat(thinnest) - (b.max - b.min)).max(Vec3::ZERO) * 0.5;
+    let b = &Aabb::new(b.min - pad, b.max + pad);
     let extent = b.max - b.min;
     let mut rays = Vec::with_capacity(n);
     while rays.len() < n {
@@ -345,21 +351,25 @@ pub struct Agreement {
 /// library and neither in another), and camera rays through a closed mesh's edges do occur.
 pub const MIN_AGREEMENT: f64 = 0.999;
 
+/// Whether two closest-hit answers agree: both miss, or both hit within [`T_TOLERANCE`].
+fn same_closest(a: Option<f32>, b: Option<f32>) -> bool {
+    match (a, b) {
+        (None, None) => true,
+        (Some(x), Some(y)) => (x - y).abs() <= T_TOLERANCE * x.abs().max(y.abs()).max(1e-3),
+        _ => false,
+    }
+}
+
 /// Compares `peer`'s answers with `reference`'s (rdbvh's), ray by ray.
 pub fn agreement(reference: &Answers, peer: &Answers) -> Agreement {
     assert_eq!(reference.closest.len(), peer.closest.len());
     assert_eq!(reference.any.len(), peer.any.len());
     let rays = reference.closest.len();
-    let same_t = |a: Option<f32>, b: Option<f32>| match (a, b) {
-        (None, None) => true,
-        (Some(x), Some(y)) => (x - y).abs() <= T_TOLERANCE * x.abs().max(y.abs()).max(1e-3),
-        _ => false,
-    };
     let closest = reference
         .closest
         .iter()
         .zip(&peer.closest)
-        .filter(|(a, b)| same_t(**a, **b))
+        .filter(|(a, b)| same_closest(**a, **b))
         .count();
     let any = reference
         .any
@@ -381,12 +391,36 @@ pub fn agreement(reference: &Answers, peer: &Answers) -> Agreement {
     }
 }
 
+/// The rays on which `peer`'s closest-hit or any-hit answer differs from `reference`'s (as
+/// [`agreement`] counts them), in order.
+pub fn disagreements(reference: &Answers, peer: &Answers) -> Vec<usize> {
+    (0..reference.closest.len())
+        .filter(|&i| {
+            !same_closest(reference.closest[i], peer.closest[i]) || reference.any[i] != peer.any[i]
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn cube() -> Aabb {
         Aabb::new(Vec3::splat(-1.0), Vec3::new(3.0, 1.0, 2.0))
+    }
+
+    #[test]
+    fn random_rays_in_a_flat_box_start_off_its_plane() {
+        let flat = Aabb::new(Vec3::new(0.0, 0.0, 2.0), Vec3::new(60.0, 30.0, 2.0));
+        let rays = random_rays(&flat, 1000, 3);
+        assert!(rays.iter().all(|r| (r.origin.z - 2.0).abs() <= 0.03 + 1e-6));
+        assert!(rays.iter().filter(|r| r.origin.z == 2.0).count() < 10);
+        // A box that is not flat keeps its rays.
+        let b = cube();
+        let widened = random_rays(&b, 100, 7);
+        assert!(widened
+            .iter()
+            .all(|r| r.origin.cmpge(b.min).all() && r.origin.cmple(b.max).all()));
     }
 
     #[test]

@@ -82,6 +82,12 @@ pub trait Library {
     fn build_mt(scene: &mut Self::Scene) -> Self::Accel {
         Self::build(scene)
     }
+    /// Why `accel` cannot be traced safely, if it cannot (checked after every build in the
+    /// comparison, before any ray): a library whose traversal would overrun its own limits is
+    /// left out rather than crash the process.
+    fn unusable(_accel: &Self::Accel) -> Option<String> {
+        None
+    }
     /// The closest hit's distance along the ray, or `None`.
     fn closest(accel: &Self::Accel, scene: &Self::Scene, ray: &Self::Ray) -> Option<f32>;
     /// Whether anything is hit along the ray.

@@ -61,6 +61,7 @@ fn every_library_agrees_with_rdbvh_on_both_trees() {
         .expect("runs");
     // obvhs (and tinybvh, with the C++ peers) are measured as two adapters each.
     let two_adapters = if cfg!(feature = "cpp-peers") { 2 } else { 1 };
+    assert_eq!(report.left_out, []);
     assert_eq!(report.runs.len(), LIBRARIES.len() + two_adapters);
     for r in &report.runs {
         for g in r.agreement.iter().chain(&r.agreement_mt) {
@@ -195,4 +196,34 @@ fn cpp_peers_agree_with_brute_force_and_rdbvh() {
             );
         }
     }
+}
+
+/// A scene of 1e-20 units: tinybvh's builds cannot split it and make trees deeper than its
+/// traversals' unchecked 256-entry stack (tracing them crashed the process). They are left out
+/// with a reason; every other library is measured.
+#[cfg(feature = "cpp-peers")]
+#[test]
+fn a_peer_whose_tree_would_overrun_its_stack_is_left_out() {
+    use rdbvh_benches::SplitMix64;
+    use rdbvh_core::geometry::Triangle;
+    use rdbvh_core::Vec3;
+
+    let mut rng = SplitMix64::new(3);
+    let mut point = |scale: f32| {
+        Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * (2.0 * scale) - scale
+    };
+    let tris: Vec<Triangle> = (0..3000)
+        .map(|_| {
+            let c = point(1e-20);
+            Triangle::new(c + point(1e-22), c + point(1e-22), c + point(1e-22))
+        })
+        .collect();
+    let report = rdbvh_benches::compare::run("tiny", &tris, &quick()).expect("runs");
+    let left_out: Vec<&str> = report.left_out.iter().map(|(name, _)| *name).collect();
+    assert!(left_out.contains(&"tinybvh-bvh8"), "{:?}", report.left_out);
+    for (_, why) in &report.left_out {
+        assert!(why.contains("traversal stack entries"), "{why}");
+    }
+    assert!(report.runs.iter().any(|r| r.name == "embree"));
+    assert!(report.text().contains("left out: tinybvh-bvh8: "));
 }

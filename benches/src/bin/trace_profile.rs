@@ -45,6 +45,20 @@ impl<L: Library> Traced<L> {
             rays: sets.iter().map(|s| L::rays(s)).collect(),
         }
     }
+
+    /// [`Traced::new`] for a peer, refused when its tree cannot be traced safely
+    /// ([`Library::unusable`]): this tool compares every peer or none.
+    #[cfg(feature = "cpp-peers")]
+    fn peer(tris: &[Triangle], sets: &[Vec<Ray>]) -> Result<Box<dyn Timed>, String>
+    where
+        L: 'static,
+    {
+        let traced = Self::new(tris, sets);
+        match L::unusable(&traced.prepared.accel) {
+            Some(why) => Err(format!("{}: {why}", L::NAME)),
+            None => Ok(Box::new(traced)),
+        }
+    }
 }
 
 /// A traced library whatever its type, so the C++ peers can be one list.
@@ -66,29 +80,26 @@ impl<L: Library> Timed for Traced<L> {
     }
 }
 
+/// A C++ peer's name in the table and its traced trees.
+type Peer = (&'static str, Box<dyn Timed>);
+
 /// The C++ peers with their names in the table: first the two default builds (the ratios'
 /// base), then the two spatial-split builds.
 #[cfg(feature = "cpp-peers")]
-fn cpp_peers(tris: &[Triangle], sets: &[Vec<Ray>]) -> Vec<(&'static str, Box<dyn Timed>)> {
+fn cpp_peers(tris: &[Triangle], sets: &[Vec<Ray>]) -> Result<Vec<Peer>, String> {
     use rdbvh_benches::peers::{Embree, EmbreeHigh, TinybvhBvh8, TinybvhBvh8Hq};
-    vec![
-        ("embree", Box::new(Traced::<Embree>::new(tris, sets))),
-        ("tinybvh8", Box::new(Traced::<TinybvhBvh8>::new(tris, sets))),
-        (
-            "embree-high",
-            Box::new(Traced::<EmbreeHigh>::new(tris, sets)),
-        ),
-        (
-            "tinybvh8-hq",
-            Box::new(Traced::<TinybvhBvh8Hq>::new(tris, sets)),
-        ),
-    ]
+    Ok(vec![
+        ("embree", Traced::<Embree>::peer(tris, sets)?),
+        ("tinybvh8", Traced::<TinybvhBvh8>::peer(tris, sets)?),
+        ("embree-high", Traced::<EmbreeHigh>::peer(tris, sets)?),
+        ("tinybvh8-hq", Traced::<TinybvhBvh8Hq>::peer(tris, sets)?),
+    ])
 }
 
 /// Without the C++ peers: none.
 #[cfg(not(feature = "cpp-peers"))]
-fn cpp_peers(_: &[Triangle], _: &[Vec<Ray>]) -> Vec<(&'static str, Box<dyn Timed>)> {
-    Vec::new()
+fn cpp_peers(_: &[Triangle], _: &[Vec<Ray>]) -> Result<Vec<Peer>, String> {
+    Ok(Vec::new())
 }
 
 /// How many of [`cpp_peers`] are default builds (the base of the unsplit trees' ratios); the
@@ -138,7 +149,13 @@ fn main() -> ExitCode {
     let wide = Traced::<RdbvhWide>::new(&tris, &sets);
     let wide8 = Traced::<RdbvhWide8>::new(&tris, &sets);
     let sbvh = Traced::<RdbvhWide8Sbvh>::new(&tris, &sets);
-    let peers = cpp_peers(&tris, &sets);
+    let peers = match cpp_peers(&tris, &sets) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
     // Per measure: rdbvh-wide, rdbvh-wide8, rdbvh-wide8-sbvh, then each C++ peer.
     let mut best = vec![vec![f64::INFINITY; RDBVH + peers.len()]; MEASURES.len()];
     let mut peer_hits = vec![0; peers.len()];

@@ -39,11 +39,17 @@ extern "C" {
     fn rdbvh_tinybvh8_free(b: *mut c_void);
     fn rdbvh_tinybvh8_closest(b: *const c_void, ray: *const c_void) -> f32;
     fn rdbvh_tinybvh8_occluded(b: *const c_void, ray: *const c_void) -> bool;
+    fn rdbvh_tinybvh8_stack_need(b: *const c_void) -> u32;
     fn rdbvh_tinybvh4_build(verts: *const f32, tris: u32, threaded: bool, hq: bool) -> *mut c_void;
     fn rdbvh_tinybvh4_free(b: *mut c_void);
     fn rdbvh_tinybvh4_closest(b: *const c_void, ray: *const c_void) -> f32;
     fn rdbvh_tinybvh4_occluded(b: *const c_void, ray: *const c_void) -> bool;
+    fn rdbvh_tinybvh4_stack_need(b: *const c_void) -> u32;
 }
+
+/// The entries of tinybvh's traversal stacks (fixed arrays in `Intersect` and `IsOccluded`, not
+/// checked while pushing).
+const STACK: u32 = 256;
 
 /// tinybvh's `BVH_FAR`: its "no end" for a ray.
 const FAR: f32 = 1e30;
@@ -115,6 +121,11 @@ pub trait Layout {
     /// # Safety
     /// As [`Layout::closest`].
     unsafe fn occluded(b: *const c_void, ray: *const c_void) -> bool;
+    /// The traversal stack entries the tree can need, whatever the ray.
+    ///
+    /// # Safety
+    /// `b` is a live tree from [`Layout::build`].
+    unsafe fn stack_need(b: *const c_void) -> u32;
 }
 
 /// `BVH8_CPU`: 8-wide nodes, AVX2 traversal.
@@ -137,6 +148,9 @@ impl Layout for Bvh8Cpu {
     unsafe fn occluded(b: *const c_void, ray: *const c_void) -> bool {
         rdbvh_tinybvh8_occluded(b, ray)
     }
+    unsafe fn stack_need(b: *const c_void) -> u32 {
+        rdbvh_tinybvh8_stack_need(b)
+    }
 }
 
 /// `BVH4_CPU`: 4-wide nodes, SSE traversal.
@@ -158,6 +172,9 @@ impl Layout for Bvh4Cpu {
     #[inline]
     unsafe fn occluded(b: *const c_void, ray: *const c_void) -> bool {
         rdbvh_tinybvh4_occluded(b, ray)
+    }
+    unsafe fn stack_need(b: *const c_void) -> u32 {
+        rdbvh_tinybvh4_stack_need(b)
     }
 }
 
@@ -264,6 +281,20 @@ impl<L: Layout, const HQ: bool> Library for Tinybvh<L, HQ> {
 
     fn build_mt(scene: &mut Self::Scene) -> Self::Accel {
         Self::build_with(scene, true)
+    }
+
+    /// A tree deeper than tinybvh's traversal stack holds (a degenerate build, as over a scene
+    /// of 1e-20 units, where its binning cannot split) would overrun the stack, which tinybvh
+    /// does not check: refused before any ray.
+    fn unusable(accel: &Self::Accel) -> Option<String> {
+        // SAFETY: a live tree.
+        let need = unsafe { L::stack_need(accel.tree) };
+        (need > STACK).then(|| {
+            format!(
+                "its tree can need {need} traversal stack entries, and its traversals hold \
+                 {STACK} unchecked"
+            )
+        })
     }
 
     #[inline]

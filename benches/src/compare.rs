@@ -1240,11 +1240,20 @@ pub fn main_with(args: impl IntoIterator<Item = String>, opts: Options) -> Resul
 mod tests {
     use super::*;
 
-    /// A peer that finds nothing: wrong on every ray that hits.
-    struct Blind;
+    /// A peer that finds nothing, wrong on every ray that hits; `OWN`: under one of rdbvh's
+    /// names, so its disagreement is rdbvh's own; `PANICS`: its build panics.
+    struct Fake<const OWN: bool, const PANICS: bool>;
 
-    impl Library for Blind {
-        const NAME: &'static str = "blind";
+    type Blind = Fake<false, false>;
+    type OwnBlind = Fake<true, false>;
+    type Panics = Fake<false, true>;
+
+    impl<const OWN: bool, const PANICS: bool> Library for Fake<OWN, PANICS> {
+        const NAME: &'static str = match (OWN, PANICS) {
+            (true, _) => "rdbvh-blind",
+            (false, true) => "panics",
+            (false, false) => "blind",
+        };
         const PARALLEL_BUILD: Option<&'static str> = None;
         type Scene = ();
         type Ray = ();
@@ -1253,52 +1262,8 @@ mod tests {
         fn rays(rays: &[Ray]) -> Vec<()> {
             vec![(); rays.len()]
         }
-        fn build(_: &mut ()) {}
-        fn closest(_: &(), _: &(), _: &()) -> Option<f32> {
-            None
-        }
-        fn any(_: &(), _: &(), _: &()) -> bool {
-            false
-        }
-    }
-
-    /// [`Blind`] under one of rdbvh's names: its disagreement is rdbvh's own.
-    struct OwnBlind;
-
-    impl Library for OwnBlind {
-        const NAME: &'static str = "rdbvh-blind";
-        const PARALLEL_BUILD: Option<&'static str> = None;
-        type Scene = ();
-        type Ray = ();
-        type Accel = ();
-        fn scene(_: &[Triangle]) {}
-        fn rays(rays: &[Ray]) -> Vec<()> {
-            Blind::rays(rays)
-        }
-        fn build(_: &mut ()) {}
-        fn closest(_: &(), _: &(), _: &()) -> Option<f32> {
-            None
-        }
-        fn any(_: &(), _: &(), _: &()) -> bool {
-            false
-        }
-    }
-
-    /// A peer whose build panics.
-    struct Panics;
-
-    impl Library for Panics {
-        const NAME: &'static str = "panics";
-        const PARALLEL_BUILD: Option<&'static str> = None;
-        type Scene = ();
-        type Ray = ();
-        type Accel = ();
-        fn scene(_: &[Triangle]) {}
-        fn rays(rays: &[Ray]) -> Vec<()> {
-            Blind::rays(rays)
-        }
         fn build(_: &mut ()) {
-            panic!("a peer's own assertion");
+            assert!(!PANICS, "a peer's own assertion");
         }
         fn closest(_: &(), _: &(), _: &()) -> Option<f32> {
             None

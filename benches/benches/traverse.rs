@@ -16,13 +16,12 @@ use clock::Clock;
 use criterion::{
     criterion_group, criterion_main, BenchmarkGroup, Criterion, SamplingMode, Throughput,
 };
+use rdbvh_benches::compare::{reference_sets, RaySet};
 use rdbvh_benches::peers::{
     BvhCrate, Library, ObvhsBvh2, ObvhsCwbvh, Parry, Prepared, Rdbvh, RdbvhWide, RdbvhWide8,
     RdbvhWide8Sbvh,
 };
-use rdbvh_benches::{
-    agreement, bounds, load_scene, ray_set, Answers, RayKind, BENCH_SCENES, MIN_AGREEMENT,
-};
+use rdbvh_benches::{agreement, load_scene, RayKind, BENCH_SCENES, MIN_AGREEMENT};
 use rdbvh_core::bvh::{AnyHit, ClosestHit};
 use rdbvh_core::geometry::{Ray, Triangle};
 
@@ -34,7 +33,7 @@ struct Subject<L: Library> {
 
 impl<L: Library> Subject<L> {
     /// Builds, converts the rays and checks agreement with rdbvh's `reference` answers.
-    fn new(scene: &str, tris: &[Triangle], sets: &[(RayKind, Vec<Ray>, Answers)]) -> Self {
+    fn new(scene: &str, tris: &[Triangle], sets: &[RaySet]) -> Self {
         let prepared = Prepared::<L>::new(tris);
         let mut rays = Vec::new();
         for (kind, set, reference) in sets {
@@ -80,17 +79,7 @@ fn traversals(c: &mut Criterion<Clock>) {
                 continue;
             }
         };
-        let b = bounds(&tris);
-        let reference = Prepared::<Rdbvh>::new(&tris);
-        let sets: Vec<(RayKind, Vec<Ray>, Answers)> =
-            [RayKind::Camera, RayKind::Random, RayKind::Shadow]
-                .into_iter()
-                .map(|kind| {
-                    let rays = ray_set(&tris, &b, kind);
-                    let answers = reference.answers(&rays);
-                    (kind, rays, answers)
-                })
-                .collect();
+        let sets = reference_sets(&tris);
         let rdbvh = Subject::<Rdbvh>::new(name, &tris, &sets);
         let wide = Subject::<RdbvhWide>::new(name, &tris, &sets);
         let wide8 = Subject::<RdbvhWide8>::new(name, &tris, &sets);

@@ -401,7 +401,22 @@ where
 }
 
 /// A ray set: its kind, its rays, and rdbvh's answers on them (the reference).
-type RaySet = (RayKind, Vec<Ray>, Answers);
+pub type RaySet = (RayKind, Vec<Ray>, Answers);
+
+/// The camera, random and shadow ray sets of `tris` ([`ray_set`]), each with the answers of
+/// rdbvh's binary BVH, which every library's are checked against.
+pub fn reference_sets(tris: &[Triangle]) -> Vec<RaySet> {
+    let b = bounds(tris);
+    let reference = Prepared::<Rdbvh>::new(tris);
+    [RayKind::Camera, RayKind::Random, RayKind::Shadow]
+        .into_iter()
+        .map(|kind| {
+            let rays = ray_set(tris, &b, kind);
+            let answers = reference.answers(&rays);
+            (kind, rays, answers)
+        })
+        .collect()
+}
 
 /// Why an adapter is not measured.
 enum Failure {
@@ -693,16 +708,7 @@ pub fn run(scene: &str, tris: &[Triangle], opts: &Options) -> Result<Report, Str
         .build()
         .map_err(|e| format!("cannot start the rayon pool: {e}"))?;
     let b = bounds(tris);
-    let reference = Prepared::<Rdbvh>::new(tris);
-    let sets: Vec<RaySet> = [RayKind::Camera, RayKind::Random, RayKind::Shadow]
-        .into_iter()
-        .map(|kind| {
-            let rays = ray_set(tris, &b, kind);
-            let answers = reference.answers(&rays);
-            (kind, rays, answers)
-        })
-        .collect();
-    drop(reference);
+    let sets = reference_sets(tris);
     let share = |a: &Answers| {
         a.closest.iter().filter(|t| t.is_some()).count() as f64 / a.closest.len().max(1) as f64
     };
@@ -1306,16 +1312,7 @@ mod tests {
         let tris = rdbvh::scene::Scene::open("builtin:random1000")
             .expect("built in")
             .triangles;
-        let b = bounds(&tris);
-        let reference = Prepared::<Rdbvh>::new(&tris);
-        let sets = [RayKind::Camera, RayKind::Random, RayKind::Shadow]
-            .into_iter()
-            .map(|kind| {
-                let rays = ray_set(&tris, &b, kind);
-                let answers = reference.answers(&rays);
-                (kind, rays, answers)
-            })
-            .collect();
+        let sets = reference_sets(&tris);
         (tris, sets)
     }
 

@@ -2,7 +2,9 @@
 //! built with `--features cpp-peers`, Embree 3 and tinybvh, each by its default and by its
 //! spatial-split build: `embree`, `embree-high`, `tinybvh`, `tinybvh8-hq`) on the same triangles
 //! and rays (see `rdbvh_benches::compare`). Bad input prints one `error: ...` line and exits with
-//! status 1.
+//! status 1; a peer that cannot be measured on the scene is left out, with a
+//! `warning: left out: NAME: why` line on stderr under `--json` (a line of the text report
+//! otherwise).
 
 use std::process::ExitCode;
 

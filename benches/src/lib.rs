@@ -326,6 +326,29 @@ pub struct Answers {
     pub closest: Vec<Option<f32>>,
     /// Any-hit answer per ray.
     pub any: Vec<bool>,
+    /// Per ray, the smallest distance [`T_TOLERANCE`] is taken of when closest hits are compared
+    /// ([`Answers::scaled_to`]); empty: `1e-3` for every ray.
+    pub floor: Vec<f32>,
+}
+
+impl Answers {
+    /// These answers as the reference for `rays` over a scene whose box has diagonal
+    /// `diagonal`: two closest hits then agree within [`T_TOLERANCE`] of the larger distance or
+    /// of a tenth of the diagonal (in the ray's units), whichever is larger. Correct
+    /// single-precision tests differ by rounding that scales with the coordinates, not with the
+    /// hit's distance: near a ray's origin, on thin triangles, a few ulps of a coordinate are
+    /// many of `t`.
+    pub fn scaled_to(mut self, rays: &[Ray], diagonal: f32) -> Self {
+        self.floor = rays
+            .iter()
+            .map(|r| 0.1 * diagonal / r.dir.length())
+            .collect();
+        self
+    }
+
+    pub(crate) fn floor(&self, i: usize) -> f32 {
+        self.floor.get(i).copied().unwrap_or(1e-3)
+    }
 }
 
 /// How far two closest-hit distances may differ and still agree: relative, since the scenes come
@@ -351,11 +374,12 @@ pub struct Agreement {
 /// library and neither in another), and camera rays through a closed mesh's edges do occur.
 pub const MIN_AGREEMENT: f64 = 0.999;
 
-/// Whether two closest-hit answers agree: both miss, or both hit within [`T_TOLERANCE`].
-fn same_closest(a: Option<f32>, b: Option<f32>) -> bool {
+/// Whether two closest-hit answers agree: both miss, or both hit within [`T_TOLERANCE`] of the
+/// larger distance or of `floor` (see [`Answers::scaled_to`]).
+pub fn same_closest(a: Option<f32>, b: Option<f32>, floor: f32) -> bool {
     match (a, b) {
         (None, None) => true,
-        (Some(x), Some(y)) => (x - y).abs() <= T_TOLERANCE * x.abs().max(y.abs()).max(1e-3),
+        (Some(x), Some(y)) => (x - y).abs() <= T_TOLERANCE * x.abs().max(y.abs()).max(floor),
         _ => false,
     }
 }
@@ -365,11 +389,8 @@ pub fn agreement(reference: &Answers, peer: &Answers) -> Agreement {
     assert_eq!(reference.closest.len(), peer.closest.len());
     assert_eq!(reference.any.len(), peer.any.len());
     let rays = reference.closest.len();
-    let closest = reference
-        .closest
-        .iter()
-        .zip(&peer.closest)
-        .filter(|(a, b)| same_closest(**a, **b))
+    let closest = (0..rays)
+        .filter(|&i| same_closest(reference.closest[i], peer.closest[i], reference.floor(i)))
         .count();
     let any = reference
         .any
@@ -396,7 +417,8 @@ pub fn agreement(reference: &Answers, peer: &Answers) -> Agreement {
 pub fn disagreements(reference: &Answers, peer: &Answers) -> Vec<usize> {
     (0..reference.closest.len())
         .filter(|&i| {
-            !same_closest(reference.closest[i], peer.closest[i]) || reference.any[i] != peer.any[i]
+            !same_closest(reference.closest[i], peer.closest[i], reference.floor(i))
+                || reference.any[i] != peer.any[i]
         })
         .collect()
 }
@@ -457,10 +479,12 @@ mod tests {
         let a = Answers {
             closest: vec![None, Some(1.0), Some(100.0), Some(2.0)],
             any: vec![false, true, true, true],
+            floor: Vec::new(),
         };
         let b = Answers {
             closest: vec![None, Some(1.00001), Some(100.5), None],
             any: vec![false, true, true, false],
+            floor: Vec::new(),
         };
         let g = agreement(&a, &b);
         assert_eq!(g.rays, 4);

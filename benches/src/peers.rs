@@ -138,6 +138,7 @@ impl<L: Library> Prepared<L> {
                 .iter()
                 .map(|r| L::any(&self.accel, &self.scene, r))
                 .collect(),
+            floor: Vec::new(),
         }
     }
 }

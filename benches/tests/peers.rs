@@ -161,6 +161,7 @@ fn cpp_peers_agree_with_brute_force_and_rdbvh() {
                 .iter()
                 .map(|r| tris.iter().any(|t| t.intersect(r, r.t_max).is_some()))
                 .collect(),
+            floor: Vec::new(),
         };
         let hits = brute.any.iter().filter(|&&h| h).count();
         assert!(

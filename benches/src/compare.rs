@@ -426,15 +426,15 @@ pub fn reference_sets(tris: &[Triangle]) -> Vec<RaySet> {
 
 /// Why an adapter is not measured.
 enum Failure {
-    /// rdbvh is wrong (one of its adapters disagrees, or brute force contradicts its answers):
-    /// the run stops.
+    /// rdbvh is at fault (one of its adapters disagrees, or its brute force gives an answer its
+    /// tree does not): the run stops.
     Fatal(String),
     /// A peer cannot be measured on this scene (wrong answers, a tree its traversal cannot
     /// take, a panic); the others are.
     LeftOut(String),
 }
 
-/// Rays of a disagreement that brute force re-traces to tell who is wrong.
+/// Rays of a disagreement that are traced again to tell whose answers are right.
 const ARBITRATED: usize = 32;
 
 /// The closest hit on `ray`'s segment over `tris` by Moller-Trumbore in double precision, two

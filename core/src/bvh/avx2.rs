@@ -172,7 +172,8 @@ where
     }
 }
 
-/// [`WideBvhN::walk`] from the root with the caller's visitor, compiled for AVX2.
+/// [`WideBvhN::walk_in`] from node `root` over the blocks `tris` with the caller's visitor,
+/// compiled for AVX2.
 ///
 /// # Safety
 ///
@@ -180,6 +181,8 @@ where
 #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
 pub(crate) unsafe fn traverse<const W: usize, V: LeafVisitor>(
     bvh: &WideBvhN<W>,
+    root: u32,
+    tris: &[Triangle4],
     ray: &Ray,
     visitor: &mut V,
     stats: &mut impl Counters,
@@ -188,8 +191,8 @@ where
     Width<W>: Lanes<W>,
 {
     match bvh.as_wide8() {
-        Some(bvh) => bvh.walk::<Avx2Lanes8, V>(0, ray, visitor, stats),
-        None => bvh.walk::<Width<W>, V>(0, ray, visitor, stats),
+        Some(bvh) => bvh.walk_in::<Avx2Lanes8, V>(root, tris, ray, visitor, stats),
+        None => bvh.walk_in::<Width<W>, V>(root, tris, ray, visitor, stats),
     }
 }
 
@@ -321,7 +324,7 @@ mod tests {
             let (mut c0, mut c1) = (HitCount::new(r), HitCount::new(r));
             wide.walk::<Width<W>, _>(0, r, &mut c0, &mut s0);
             // SAFETY: as above.
-            unsafe { traverse(wide, r, &mut c1, &mut s1) };
+            unsafe { traverse(wide, 0, wide.triangles(), r, &mut c1, &mut s1) };
             assert_eq!((c0.hits, s0), (c1.hits, s1), "all hits, ray {i}");
         }
         hits

@@ -570,13 +570,28 @@ where
         visitor: &mut V,
         stats: &mut impl Counters,
     ) -> bool {
+        self.traverse_in(0, &self.tris, ray, visitor, stats)
+    }
+
+    /// [`WideBvhN::traverse`] from node `root` of a forest whose leaves name blocks of `tris`
+    /// (see [`WideBvhN::any_hit_from`]), with no root-box test, through the AVX2 entry point
+    /// where the CPU has it.
+    #[inline(always)]
+    pub(crate) fn traverse_in<V: LeafVisitor>(
+        &self,
+        root: u32,
+        tris: &[Triangle4],
+        ray: &Ray,
+        visitor: &mut V,
+        stats: &mut impl Counters,
+    ) -> bool {
         #[cfg(target_arch = "x86_64")]
         if super::dispatch::avx2_entry::<W>() {
             // SAFETY: `avx2_entry` is true only once the CPU was seen to have what the entry
             // points are compiled for.
-            return unsafe { super::avx2::traverse(self, ray, visitor, stats) };
+            return unsafe { super::avx2::traverse(self, root, tris, ray, visitor, stats) };
         }
-        self.walk::<Width<W>, V>(0, ray, visitor, stats)
+        self.walk_in::<Width<W>, V>(root, tris, ray, visitor, stats)
     }
 
     /// The closest hit on `[ray.t_min, ray.t_max]`, exactly as the binary BVH and brute force

@@ -8,8 +8,8 @@ use wide::f32x4;
 use super::cell::{face_coords, FACES};
 use super::source::LightSource;
 use super::subdivide::LightBufferBuilder;
-use crate::bvh::{Counters, TraversalStats, WideBvh8};
-use crate::geometry::{Ray, Triangle};
+use crate::bvh::{ClosestHitEdges, Counters, Hit, TraversalStats, WideBvh8};
+use crate::geometry::{Ray, Triangle, TriangleEdges};
 use crate::BuildError;
 
 /// A grid cell the light does not illuminate: its segments are not the buffer's to answer.
@@ -235,6 +235,77 @@ impl LightBuffer {
                 // The cell's face: its index over `r * r`, a power of two.
                 let face = cell >> (2 * self.resolution.trailing_zeros());
                 Some(self.forests[face as usize].any_hit_from(root, &scene.tris, ray, stats))
+            }
+        }
+    }
+
+    /// The finest grid cell that answers `ray` as a ray leaving the source: it starts on the
+    /// light (its origin within the light's box grown by the buffer's margin, where the shadow
+    /// segments it answers may end), and the cell is that of its direction. `None` for any other ray, or a `scene` of
+    /// another size. A cell's tree holds every triangle a segment of its directions can cross
+    /// from anywhere on the light, so it holds every triangle such a ray can hit, however far:
+    /// the buffer of a point light placed at a pinhole camera's eye answers the camera's rays
+    /// (the item buffer of Weghorst, Hooper and Greenberg 1984, made exact).
+    #[inline]
+    pub fn cell_leaving(&self, scene: &WideBvh8, ray: &Ray) -> Option<u32> {
+        let (lo, hi) = self.end_box;
+        let o = f32x4::from([ray.origin.x, ray.origin.y, ray.origin.z, 0.0]);
+        if (scene.nodes.len(), scene.tris.len()) != self.scene_size
+            || !(lo.simd_le(o) & o.simd_le(hi)).all()
+        {
+            return None;
+        }
+        Some(self.cell(ray.dir) as u32)
+    }
+
+    /// The closest hit of `ray`, a ray leaving the source, with its triangle's edges from the
+    /// scene BVH's block: exactly what [`WideBvh8::closest_hit_edges`] on `scene` finds,
+    /// through one cell's tree. `None` for a ray that is not the buffer's (see
+    /// [`LightBuffer::cell_leaving`]) or that leaves the light where it sends no light; then
+    /// `Some(None)` means no hit at all. The lookup counts as one inner node in `stats`.
+    #[inline]
+    pub fn closest_hit_leaving_with_stats(
+        &self,
+        scene: &WideBvh8,
+        ray: &Ray,
+        stats: &mut TraversalStats,
+    ) -> Option<Option<(Hit, TriangleEdges)>> {
+        self.closest_leaving(scene, ray, stats)
+    }
+
+    /// [`LightBuffer::closest_hit_leaving_with_stats`] without counting.
+    #[inline]
+    pub fn closest_hit_leaving(
+        &self,
+        scene: &WideBvh8,
+        ray: &Ray,
+    ) -> Option<Option<(Hit, TriangleEdges)>> {
+        self.closest_leaving(scene, ray, &mut ())
+    }
+
+    #[inline(always)]
+    fn closest_leaving(
+        &self,
+        scene: &WideBvh8,
+        ray: &Ray,
+        stats: &mut impl Counters,
+    ) -> Option<Option<(Hit, TriangleEdges)>> {
+        let cell = self.cell_leaving(scene, ray)?;
+        stats.node();
+        match *self.grid.get(cell as usize)? {
+            DARK => None,
+            CLEAR => Some(None),
+            root => {
+                let face = cell >> (2 * self.resolution.trailing_zeros());
+                let mut visitor = ClosestHitEdges::new(ray);
+                self.forests[face as usize].traverse_in(
+                    root,
+                    &scene.tris,
+                    ray,
+                    &mut visitor,
+                    stats,
+                );
+                Some(visitor.best)
             }
         }
     }

@@ -331,3 +331,61 @@ fn the_scene_bvh_must_be_the_scenes() {
     assert!(b.occluded(&ray).is_some());
     assert_eq!(b.buffer.occluded(&scene_of(&tris[..200]), &ray), None);
 }
+
+/// Rays leaving a point or a spot (a camera's eye, with its view as the cone): every closest hit
+/// the buffer gives is brute force's and, with its edges, the scene BVH's, bit for bit; rays
+/// inside the cone are all answered, rays from elsewhere none.
+#[test]
+fn rays_leaving_the_source_find_the_closest_hit_as_brute_force_does() {
+    let mut rng = Pcg32::new(9);
+    let tris = soup(1500, &mut rng);
+    let key = |h: Option<crate::bvh::Hit>| h.map(|h| (h.t.to_bits(), h.triangle, h.u.to_bits()));
+    let axis = Vec3::new(0.3, -0.2, 1.0).normalize();
+    for (eye, cone, opts) in [
+        (Vec3::new(5.0, 5.0, 5.0), None, options(6, 8)),
+        (Vec3::new(5.0, 6.0, -8.0), Some(0.7f32), options(4, 64)),
+        (tris[3].v2, None, options(5, 4)),
+        (
+            Vec3::new(5.0, 5.0, 5.0),
+            Some(core::f32::consts::FRAC_PI_2),
+            options(3, 16),
+        ),
+    ] {
+        let source = match cone {
+            Some(half) => LightSource::spot(eye, axis, half).unwrap(),
+            None => LightSource::point(eye).unwrap(),
+        };
+        let b = built(&tris, source, &opts).unwrap();
+        let (mut answered, mut inside, mut hits) = (0, 0, 0);
+        for i in 0..4000 {
+            let d = point_in(&mut rng, -1.0, 1.0);
+            let t_min = if i % 3 == 0 { rng.range(0.0, 4.0) } else { 0.0 };
+            let Ok(ray) = Ray::segment(eye, d, t_min, f32::INFINITY) else {
+                continue;
+            };
+            if cone.is_none_or(|half| d.normalize().dot(axis) >= libm::cosf(half) + 1e-4) {
+                inside += 1;
+            }
+            let mut stats = TraversalStats::default();
+            let Some(found) = b
+                .buffer
+                .closest_hit_leaving_with_stats(&b.scene, &ray, &mut stats)
+            else {
+                continue;
+            };
+            answered += 1;
+            let expected = brute_force::closest_hit(&ray, &tris);
+            assert_eq!(key(found.map(|f| f.0)), key(expected), "ray {i}");
+            let scene = b.scene.closest_hit_edges(&ray);
+            assert_eq!(found.map(|f| f.1), scene.map(|s| s.1), "edges, ray {i}");
+            assert_eq!(b.buffer.closest_hit_leaving(&b.scene, &ray), Some(found));
+            hits += usize::from(found.is_some());
+        }
+        assert!(answered >= inside, "{answered} answered, {inside} inside");
+        assert!(hits > 100, "{hits} hits");
+        // Rays from elsewhere are not the buffer's.
+        let off = Ray::segment(eye + Vec3::new(0.5, 0.0, 0.0), axis, 0.0, f32::INFINITY).unwrap();
+        assert_eq!(b.buffer.closest_hit_leaving(&b.scene, &off), None);
+        assert_eq!(b.buffer.cell_leaving(&b.scene, &off), None);
+    }
+}

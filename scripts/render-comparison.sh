@@ -79,7 +79,8 @@ def best(s):
     for key in ("shadow_ms", "render_ms", "build_ms"):
         j[key] = min(r[key] for r in runs)
     j["total_ms"] = min(r["render_ms"] + r["build_ms"] for r in runs)
-    # The light buffers and the choice among them, apart from the global BVH and the pilot.
+    # The light buffers, the eye buffer and the choice among them, apart from the global BVH and
+    # the pilot.
     j["buffers_x"] = min((r["build_ms"] - r["global_build_ms"] - r["pilot_ms"]) / r["global_build_ms"]
                          for r in runs)
     # Each repeat's frame + build over global's in the same repeat (the three ran back to
@@ -99,8 +100,10 @@ def tests(j):
         f"{j['shadow_node_tests'] / n:.2f} + {j['shadow_triangle_tests'] / n:.2f}"
 def parts(j):
     if j["structure"] == "lights":
+        eye = {True: "kept", False: "dropped"}[j["eye_buffer"]] if j["eye_buffer_tests"] else "not built"
         return (f"{j['light_buffers']} kept, {j['light_buffers_dropped']} dropped; "
-                f"buffers {j['buffers_x']:.2f}x global")
+                f"buffers {j['buffers_x']:.2f}x global; eye buffer {eye}"
+                + (f" ({j['eye_buffer_tests']:.2f}x the camera rays' tests)" if j["eye_buffer_tests"] else ""))
     if j["structure"] == "thesis":
         return f"{j['influence_areas']} areas"
     return ""

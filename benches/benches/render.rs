@@ -5,6 +5,8 @@
 //! - `render/SCENE/shadow/{global,lights,thesis}`: the frame's shadow segments answered on one
 //!   thread, as `shadow_ms` replays them: in the frame's batches, each in the structure's order
 //!   (throughput in segments);
+//! - `render/SCENE/camera/{global,lights}`: the frame's camera rays on one thread, through the
+//!   global BVH and through `lights` (its eye buffer where the pilot kept one);
 //! - `render/SCENE/in_frame/{closest_alone,global,lights,thesis}`: the same shadow segments
 //!   with the frame's camera and bounce rays (closest hit, through the structure's global BVH)
 //!   in their frame order and ratio, on one thread, as the renderer traces them: a structure
@@ -33,7 +35,7 @@ use rdbvh::render::{
 };
 use rdbvh::scene::Scene;
 use rdbvh_benches::scenes_dir;
-use rdbvh_core::bvh::TraversalStats;
+use rdbvh_core::bvh::{Hit, TraversalStats};
 use rdbvh_core::geometry::Ray;
 
 const SIZE: (u32, u32) = (128, 128);
@@ -87,6 +89,15 @@ const CASES: [Case; 4] = [
     },
 ];
 
+/// A frame's shadow segments, the sizes of its batches, its closest-hit rays (camera and bounce,
+/// merged) and its camera rays with their hits.
+type FrameRays = (
+    Vec<ShadowRay>,
+    Vec<usize>,
+    Vec<Ray>,
+    Vec<(Ray, Option<Hit>)>,
+);
+
 /// A loaded case: the scene, its lights and where the camera looks from.
 struct Loaded {
     scene: Scene,
@@ -132,7 +143,7 @@ impl Loaded {
         let built = match kind {
             StructureKind::Lights => {
                 let size = pilot_size(SIZE.0, SIZE.1);
-                let camera = self.camera(size);
+                let camera = self.camera(SIZE);
                 // The buffers the comparison's full frame repays, whose shadow segments this
                 // smaller frame samples: at its own size, the pilot would find none worth it.
                 let full_frame = 512 * 512 * 16;
@@ -152,10 +163,10 @@ impl Loaded {
         built.expect("the structure builds")
     }
 
-    /// The frame's shadow segments, the sizes of the batches `lights` answers them in, and its
-    /// camera and bounce rays (merged in frame order, in their ratio): the rays are every
-    /// structure's, the batches those of `structure`.
-    fn frame_rays(&self, structure: &Structure) -> (Vec<ShadowRay>, Vec<usize>, Vec<Ray>) {
+    /// The frame's shadow segments, the sizes of the batches `lights` answers them in, its
+    /// camera and bounce rays (merged in frame order, in their ratio), and its camera rays with
+    /// their hits: the rays are every structure's, the batches those of `structure`.
+    fn frame_rays(&self, structure: &Structure) -> FrameRays {
         let integrator =
             Integrator::new(&self.scene, &self.lights, structure, BOUNCES).expect("an integrator");
         let settings = FrameSettings {
@@ -182,7 +193,13 @@ impl Loaded {
                 b += 1;
             }
         }
-        (frame.shadow_rays, frame.shadow_batches, closest)
+        let camera_rays = camera.clone();
+        (
+            frame.shadow_rays,
+            frame.shadow_batches,
+            closest,
+            camera_rays,
+        )
     }
 }
 
@@ -201,7 +218,7 @@ fn render(c: &mut Criterion) {
             StructureKind::Thesis,
         ];
         let structures: Vec<Structure> = kinds.iter().map(|&k| loaded.build(k)).collect();
-        let (shadow, batches, closest) = loaded.frame_rays(&structures[1]);
+        let (shadow, batches, closest, camera) = loaded.frame_rays(&structures[1]);
         let mut group = c.benchmark_group(format!("render/{}/shadow", case.name));
         group
             .throughput(Throughput::Elements(shadow.len() as u64))
@@ -233,6 +250,7 @@ fn render(c: &mut Criterion) {
             });
         }
         group.finish();
+        camera_rays(c, case.name, &kinds[..2], &structures[..2], &camera);
         in_frame(
             c,
             case.name,
@@ -267,6 +285,53 @@ fn replay(structure: &Structure, shadow: &[ShadowRay], batches: &[usize]) -> usi
         &mut BatchOrder::default(),
     );
     answers.iter().filter(|&&a| a).count()
+}
+
+/// The `camera` group: the frame's camera rays on one thread through `global` and `lights`
+/// (its eye buffer where the pilot kept one), after a check that both find the frame's hits,
+/// with each one's node + triangle tests a ray printed.
+fn camera_rays(
+    c: &mut Criterion,
+    name: &str,
+    kinds: &[StructureKind],
+    structures: &[Structure],
+    camera: &[(Ray, Option<Hit>)],
+) {
+    let mut group = c.benchmark_group(format!("render/{name}/camera"));
+    group
+        .throughput(Throughput::Elements(camera.len() as u64))
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(2));
+    for (kind, structure) in kinds.iter().zip(structures) {
+        let mut stats = TraversalStats::default();
+        for (ray, hit) in camera {
+            let found = structure.closest_hit_camera_counted(ray, &mut stats);
+            assert_eq!(found, *hit, "{} finds the frame's hit", kind.name());
+        }
+        let n = camera.len().max(1) as f64;
+        eprintln!(
+            "render/{name}/camera/{}: {} rays, {:.2} nodes + {:.2} triangles a ray{}",
+            kind.name(),
+            camera.len(),
+            f64::from(stats.inner_nodes) / n,
+            f64::from(stats.triangles) / n,
+            if structure.eye_buffer().is_some() {
+                " (eye buffer)"
+            } else {
+                ""
+            }
+        );
+        group.bench_function(kind.name(), |b| {
+            b.iter(|| {
+                black_box(camera)
+                    .iter()
+                    .filter(|(r, _)| structure.closest_hit_camera(r).is_some())
+                    .count()
+            })
+        });
+    }
+    group.finish();
 }
 
 /// The `in_frame` group: the shadow segments with their share of the frame's closest-hit rays

@@ -201,6 +201,8 @@ fn json_has_the_contract_keys() {
         "pilot_shadow_rays",
         "influence_areas",
         "influence_area_triangles",
+        "eye_buffer",
+        "eye_buffer_tests",
     ] {
         assert!(json.get(key).is_some(), "{key} missing: {json}");
     }
@@ -467,6 +469,76 @@ fn cornell_box_with_every_light_kind_is_identical_across_structures() {
     for (ray, row) in recorded.iter().zip(&rows) {
         let blocked = row.split(',').nth(1) == Some("1");
         assert_eq!(blocked, brute_force::any_hit(ray, &triangles), "{row}");
+    }
+}
+
+/// Sibenik seen down its nave: the pilot keeps the eye buffer (its camera rays need about 0.6x
+/// the global BVH's tests through it), the image is the global BVH's byte for byte, and the
+/// recorded camera hits, answered through the eye buffer, are brute force's.
+#[test]
+fn the_eye_buffer_answers_camera_rays_as_brute_force_does() {
+    let Some(scenes) = shared_scenes("the_eye_buffer_answers_camera_rays_as_brute_force_does")
+    else {
+        return;
+    };
+    let dir = scratch("eye");
+    let obj = scenes.join("sibenik.obj");
+    // 64 x 64 at 128 samples: enough camera rays to repay the buffer's build.
+    let scene = [
+        obj.to_str().unwrap(),
+        "--eye",
+        "1200,300,100",
+        "--look-at",
+        "-1000,300,100",
+        "--fov",
+        "70",
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--spp",
+        "128",
+        "--max-bounces",
+        "0",
+    ];
+    let global = render(&scene, &dir.join("g.png"), &[]);
+    let rays = dir.join("rays");
+    let lights = render(
+        &scene,
+        &dir.join("l.png"),
+        &[
+            "--structure",
+            "lights",
+            "--record-rays",
+            rays.to_str().unwrap(),
+            "--record-limit",
+            "2000",
+        ],
+    );
+    assert_eq!(lights["eye_buffer"], true, "{lights}");
+    assert!(
+        lights["eye_buffer_tests"].as_f64().unwrap() <= 0.7,
+        "{lights}"
+    );
+    assert_eq!(global["eye_buffer"], false);
+    assert_eq!(
+        std::fs::read(dir.join("g.png")).unwrap(),
+        std::fs::read(dir.join("l.png")).unwrap()
+    );
+    let triangles = Scene::open(obj.to_str().unwrap()).unwrap().triangles;
+    let recorded = read_rays(&rays.join("camera_rays.csv")).unwrap();
+    let hits = std::fs::read_to_string(rays.join("camera_hits.csv")).unwrap();
+    let rows: Vec<&str> = hits.lines().skip(1).collect();
+    assert_eq!((recorded.len(), rows.len()), (2000, 2000));
+    for (ray, row) in recorded.iter().zip(&rows) {
+        let truth = brute_force::closest_hit(ray, &triangles);
+        let cells: Vec<&str> = row.split(',').collect();
+        assert_eq!(
+            cells[2].parse::<u32>().ok(),
+            truth.map(|h| h.triangle),
+            "{row}"
+        );
+        assert_eq!(cells[1].parse::<f32>().ok(), truth.map(|h| h.t), "{row}");
     }
 }
 

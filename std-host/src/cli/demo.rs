@@ -143,7 +143,8 @@ intensity = [20.0, 20.0, 20.0]
 ";
 
 /// Renders the room with next event estimation through both structures, checks that the images
-/// are byte-identical, writes one, and prints what the shadow rays cost through each.
+/// are byte-identical, writes one, and prints what the shadow rays cost through each, and what
+/// the camera rays cost through `lights`'s eye buffer.
 fn render_room(out: &mut impl Write, image: &Path) -> Result<(), CliError> {
     let w = |out: &mut dyn Write, text: String| writeln!(out, "{text}").map_err(CliError::Stdout);
     let image_arg = image.to_string_lossy();
@@ -218,6 +219,24 @@ fn render_room(out: &mut impl Write, image: &Path) -> Result<(), CliError> {
                 per_ray(r.shadow_triangle_tests),
                 r.shadow_ms,
                 r.shadow_ms / global.shadow_ms.max(1e-9)
+            ),
+        )?;
+    }
+    if lights.eye_buffer_tests > 0.0 {
+        w(
+            out,
+            format!(
+                "  lights' eye buffer for the camera rays: {:.2}x the global BVH's tests on the \
+                 pilot frame's, {}",
+                lights.eye_buffer_tests,
+                if lights.eye_buffer {
+                    "kept".to_string()
+                } else {
+                    format!(
+                        "dropped (kept at {:.2}x or less)",
+                        crate::render::KEEP_RATIO
+                    )
+                }
             ),
         )?;
     }

@@ -122,8 +122,8 @@ pub fn render() -> String {
          --threads. The image is the mean of --spp samples, clamped to [0, 1], sRGB-encoded, 8\n\
          bits; 16 x 16 tiles run on the threads, with a progress bar when standard error is a\n\
          terminal.\n\
-         Structures: camera and bounce rays go through the global BVH (binned SAH, reinsertion,\n\
-         8-wide nodes). Shadow segments go through --structure: global, the same BVH; lights, a\n\
+         Structures: bounce rays go through the global BVH (binned SAH, reinsertion, 8-wide\n\
+         nodes). Shadow segments go through --structure: global, the same BVH; lights, a\n\
          light buffer per light (a cube map of directions around it, each cell holding a BVH of\n\
          what segments toward the light through that cell can hit; emissive triangles are\n\
          clustered per material, at most 32 buffers, for the most powerful lights), with the\n\
@@ -138,7 +138,12 @@ pub fn render() -> String {
          in batches of consecutive tiles (about 32768 samples), and each batch's shadow\n\
          segments are answered together, cell by cell of the buffers, so that a cell's tree\n\
          stays in the caches; the radiance is then summed in each path's order, bit for bit\n\
-         as if answered one by one.\n\
+         as if answered one by one. lights also gives the camera rays an eye buffer: the\n\
+         buffer of a spot light at the eye whose cone is the view, each cell holding a BVH of\n\
+         what the camera rays through it can hit. The pilot's camera rays (one per pixel)\n\
+         decide it by the same two rules: built only if the frame's camera rays could repay\n\
+         it, kept only at 0.7 of the global BVH's tests or fewer. Camera rays go through the\n\
+         global BVH otherwise, and with global and thesis.\n\
          thesis, the thesis's own structure with influence areas made from the lights: six\n\
          90-degree frustums around a point light (one per cube face, apex at the light, to the\n\
          scene's far end), one frustum along a spot of at most 120 degrees (six for a wider one),\n\
@@ -154,7 +159,8 @@ pub fn render() -> String {
          counters, in the frame's batches; the replay's answers must equal the frame's.\n\
          --json prints one object as the last line, with the keys scene, triangles, lights,\n\
          light_buffers, light_buffers_dropped, light_buffers_skipped, pilot_shadow_rays,\n\
-         influence_areas, influence_area_triangles, width, height, spp, max_bounces, seed,\n\
+         eye_buffer (true when kept), eye_buffer_tests (its tests on the pilot's camera rays\n\
+         over the global BVH's, 0 when not built), influence_areas, influence_area_triangles, width, height, spp, max_bounces, seed,\n\
          threads, structure, build_ms, global_build_ms, pilot_ms, render_ms, camera_rays,\n\
          shadow_rays, bounce_rays, shadow_occluded, shadow_node_tests, shadow_triangle_tests,\n\
          shadow_replay_rays, shadow_ms, mean_luminance and out.\n\

@@ -65,8 +65,8 @@ pub struct RenderArgs {
     /// Vertical field of view in degrees, in (0, 180).
     #[arg(long, value_name = "DEG", default_value_t = DEFAULT_FOV_DEG)]
     pub fov: f32,
-    /// Which structure answers the shadow rays (camera and bounce rays always use the global
-    /// BVH); every structure gives the same image, byte for byte.
+    /// Which structure answers the shadow rays (and, for `lights`, the camera rays; bounce rays
+    /// always use the global BVH); every structure gives the same image, byte for byte.
     #[arg(long, value_enum, default_value_t = StructureKind::Global)]
     pub structure: StructureKind,
     /// Single-thread replays of the frame's shadow rays for shadow_ms (the best one counts).
@@ -120,6 +120,12 @@ pub struct RenderReport {
     pub light_buffers_skipped: usize,
     /// Shadow segments of the pilot frame (0 when there was no buffer to decide on).
     pub pilot_shadow_rays: usize,
+    /// Whether the camera rays go through an eye buffer (`lights` only): a light buffer at the
+    /// camera's eye, kept where the pilot frame's camera rays show that it pays.
+    pub eye_buffer: bool,
+    /// The eye buffer's node and triangle tests on the pilot frame's camera rays over the
+    /// global BVH's (0 when it was not built).
+    pub eye_buffer_tests: f64,
     /// Influence areas of the `thesis` structure (0 for the others): frustums of point and
     /// spot lights plus oriented boxes of quad lights and emissive clusters.
     pub influence_areas: usize,
@@ -225,24 +231,21 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
             scene.bounds.center(),
         ),
     };
-    let camera_of = |(width, height)| {
-        Camera::new(
-            args.eye.unwrap_or(eye),
-            args.look_at.unwrap_or(look_at),
-            args.up.unwrap_or(Vec3::Y),
-            args.fov,
-            width,
-            height,
-        )
-    };
-    let camera = camera_of((args.width, args.height))?;
+    let camera = Camera::new(
+        args.eye.unwrap_or(eye),
+        args.look_at.unwrap_or(look_at),
+        args.up.unwrap_or(Vec3::Y),
+        args.fov,
+        args.width,
+        args.height,
+    )?;
     let size = pilot_size(args.width, args.height);
     let (structure, pilot) = match args.structure {
         StructureKind::Lights => build_lights(
             &scene,
             &lights,
             args.max_bounces,
-            &camera_of(size)?,
+            &camera,
             size,
             args.seed,
             u64::from(args.width) * u64::from(args.height) * u64::from(args.spp),
@@ -295,6 +298,8 @@ pub(super) fn render(args: &RenderArgs) -> Result<RenderReport, CliError> {
         light_buffers_dropped: pilot.dropped,
         light_buffers_skipped: pilot.skipped,
         pilot_shadow_rays: pilot.shadow_rays,
+        eye_buffer: pilot.eye.kept,
+        eye_buffer_tests: pilot.eye.test_ratio,
         influence_areas: thesis.point_areas + thesis.plane_areas,
         influence_area_triangles: thesis.local_triangles,
         width: args.width,
@@ -374,6 +379,15 @@ fn print_summary(r: &RenderReport, out: &mut impl Write) -> std::io::Result<()> 
             ),
         }
     )?;
+    if r.eye_buffer_tests > 0.0 {
+        writeln!(
+            out,
+            "eye buffer {}: the pilot frame's camera rays need {:.2}x the global BVH's tests \
+             through it",
+            if r.eye_buffer { "kept" } else { "dropped" },
+            r.eye_buffer_tests
+        )?;
+    }
     writeln!(
         out,
         "frame {:.1} ms: rays per second of the frame",

@@ -15,8 +15,13 @@ pub const DEFAULT_FOV_DEG: f32 = 50.0;
 pub struct Camera {
     eye: Vec3,
     forward: Vec3,
+    /// `right` and `up` are the image plane's half-extents at unit distance: unit vectors scaled
+    /// by the tangents of the half fields of view.
     right: Vec3,
     up: Vec3,
+    /// The unit right vector and the vertical tangent, to make the camera at another size.
+    unit_right: Vec3,
+    tan_y: f32,
     width: f32,
     height: f32,
 }
@@ -60,17 +65,56 @@ impl Camera {
                 "--up {up} must not be zero or parallel to the viewing direction"
             ));
         }
-        let image_up = right.cross(forward);
         let tan_y = (fov_deg.to_radians() * 0.5).tan();
+        Ok(Self::from_basis(eye, forward, right, tan_y, width, height))
+    }
+
+    /// The camera at `eye` looking along the unit `forward`, with the unit `right` at right
+    /// angles to it and a vertical half field of view of tangent `tan_y`.
+    fn from_basis(
+        eye: Vec3,
+        forward: Vec3,
+        right: Vec3,
+        tan_y: f32,
+        width: u32,
+        height: u32,
+    ) -> Self {
+        let image_up = right.cross(forward);
         let tan_x = tan_y * width as f32 / height as f32;
-        Ok(Self {
+        Self {
             eye,
             forward,
             right: right * tan_x,
             up: image_up * tan_y,
+            unit_right: right,
+            tan_y,
             width: width as f32,
             height: height as f32,
-        })
+        }
+    }
+
+    /// The same camera over a `width x height` image (not empty): bit for bit what
+    /// [`Camera::new`] makes from this one's arguments at that size. The pilot frame's camera.
+    pub fn resized(&self, width: u32, height: u32) -> Self {
+        Self::from_basis(
+            self.eye,
+            self.forward,
+            self.unit_right,
+            self.tan_y,
+            width.max(1),
+            height.max(1),
+        )
+    }
+
+    /// The cone every ray of [`Camera::ray`] leaves the eye in: its unit axis (the viewing
+    /// direction) and its half-angle in radians, the angle to the image's corners, widened by
+    /// 1 % so that rounding leaves no ray outside. At most a right angle.
+    pub fn view_cone(&self) -> (Vec3, f32) {
+        let corner = (self.right + self.up).length().atan();
+        (
+            self.forward,
+            (corner * 1.01).min(core::f32::consts::FRAC_PI_2),
+        )
     }
 
     /// The default camera: on the `+z` side of `bounds`, looking along `-z` at their centre, `y`
@@ -150,6 +194,28 @@ mod tests {
             (corner - Vec3::new(-2.0, 1.0, -1.0)).length() < 1e-5,
             "{corner}"
         );
+    }
+
+    #[test]
+    fn a_resized_camera_is_the_one_made_at_that_size_and_its_rays_stay_in_its_cone() {
+        let (eye, at) = (Vec3::new(1.0, 2.0, 3.0), Vec3::new(-4.0, 2.5, 0.3));
+        for (fov, w, h) in [
+            (60.0, 512, 512),
+            (75.0, 640, 360),
+            (170.0, 3, 900),
+            (1.0, 1, 1),
+        ] {
+            let big = Camera::new(eye, at, Vec3::Y, fov, w, h).unwrap();
+            let (pw, ph) = ((w / 8).max(1), (h / 8).max(1));
+            let small = Camera::new(eye, at, Vec3::Y, fov, pw, ph).unwrap();
+            assert_eq!(big.resized(pw, ph), small, "{fov} {w} {h}");
+            let (axis, half) = big.view_cone();
+            assert!(half <= core::f32::consts::FRAC_PI_2);
+            for (x, y) in [(0, 0), (w, 0), (0, h), (w, h), (w / 2, h / 3)] {
+                let d = big.ray(x as f32, y as f32).dir.normalize();
+                assert!(d.dot(axis).acos() < half, "{fov} {w} {h}: corner {x},{y}");
+            }
+        }
     }
 
     #[test]

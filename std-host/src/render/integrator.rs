@@ -178,7 +178,11 @@ impl<'a> Integrator<'a> {
         let mut throughput = Vec3::ONE;
         let mut ray = camera_ray;
         for depth in 0..=self.max_bounces {
-            let found = self.structure.closest_hit(&ray);
+            let found = if depth == 0 {
+                self.structure.closest_hit_camera(&ray)
+            } else {
+                self.structure.closest_hit(&ray)
+            };
             observer.closest(depth, &ray, found.as_ref().map(|(hit, _)| hit));
             let Some((hit, t)) = found else { break };
             let id = hit.triangle as usize;

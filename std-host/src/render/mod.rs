@@ -13,11 +13,12 @@
 //!   Russian roulette from the third vertex ([`integrator`]).
 //! - **Determinism.** Every random number is a hash of (seed, pixel, sample, dimension)
 //!   ([`sampler`]): the image depends on the seed alone, not on threads or tiles.
-//! - **Structures.** Camera and bounce rays go through the global BVH; shadow segments through
-//!   the [`Structure`] chosen (`global`; `lights`: a light buffer per light where a pilot
-//!   frame shows it pays, [`pilot`]; or `thesis`: the thesis's influence areas, octree and
-//!   fallback, [`ThesisStructure`]). All answer
-//!   exactly as the global BVH does, so their images are byte-identical.
+//! - **Structures.** Bounce rays go through the global BVH; camera rays and shadow segments
+//!   through the [`Structure`] chosen (`global`; `lights`: a light buffer per light, and one at
+//!   the camera's eye for the camera rays ([`eye_buffer`]), each where a pilot frame shows it
+//!   pays, [`pilot`]; or `thesis`: the thesis's influence areas, octree and fallback for the
+//!   shadow segments, [`ThesisStructure`]). All answer exactly as the global BVH does, so their
+//!   images are byte-identical.
 //! - **Batches.** Where the structure answers shadow segments fastest together (`lights` with a
 //!   buffer: cell by cell), a frame traces its paths in batches of tiles and answers each
 //!   batch's segments at once, then sums every path's radiance in its own order
@@ -29,6 +30,7 @@
 mod camera;
 mod direction;
 mod error;
+pub mod eye_buffer;
 mod frame;
 mod image;
 pub mod integrator;
@@ -45,6 +47,7 @@ mod thesis;
 pub use self::image::{encode_png, mean_luminance, srgb, to_srgb8};
 pub use camera::{Camera, DEFAULT_FOV_DEG};
 pub use error::RenderError;
+pub use eye_buffer::EyeBufferReport;
 pub use frame::{
     render_frame, Frame, FrameCounters, FrameSettings, RecordedRays, REPLAY_CAP, TILE,
 };

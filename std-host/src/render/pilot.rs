@@ -20,6 +20,7 @@ use std::time::Instant;
 
 use rdbvh_core::bvh::TraversalStats;
 
+use super::eye_buffer::{install_eye_buffer, EyeBufferReport};
 use super::light_structure::{build_buffers, light_groups};
 use super::{
     render_frame, Camera, FrameSettings, Integrator, LightSet, RenderError, Structure,
@@ -49,6 +50,8 @@ pub struct PilotReport {
     pub skipped: usize,
     /// Wall-clock milliseconds of the pilot frame (its render, through the global BVH).
     pub ms: f64,
+    /// The eye buffer's decision ([`super::eye_buffer`]).
+    pub eye: EyeBufferReport,
 }
 
 /// Renders the pilot frame of `camera` (made at the pilot's resolution, `width` x `height`)
@@ -90,12 +93,14 @@ fn decide(
 }
 
 /// The `lights` structure built with the pilot frame deciding first: the global BVH, the pilot
-/// frame of `camera` (made at [`pilot_size`], `size`) traced through it, then a buffer built only
+/// frame of the frame's `camera` (made at [`pilot_size`], `size`) traced through it, then a
+/// buffer built only
 /// for the light groups whose pilot segments leave it a chance to pay
 /// ([`MAX_EXTENT_RATIO`]) in a frame of `frame_samples` samples ([`BUILD_TESTS_PER_TRIANGLE`]), and of those
 /// kept only the ones that need at most [`KEEP_RATIO`] of the global BVH's tests on the same
 /// segments. The pilot's segments do not depend on the structure (every structure answers
-/// alike), so one pilot serves both decisions.
+/// alike), so one pilot serves both decisions. Last, the eye buffer for the camera rays, decided
+/// by the pilot camera's rays in the same way ([`super::eye_buffer`]).
 pub fn build_lights(
     scene: &Scene,
     lights: &LightSet,
@@ -123,10 +128,11 @@ pub fn build_lights(
         record_limit: 0,
         progress: false,
     };
+    let pilot_camera = camera.resized(size.0, size.1);
     let pilot_start = Instant::now();
     let pilot = render_frame(
         &Integrator::new(scene, lights, &structure, max_bounces)?,
-        camera,
+        &pilot_camera,
         &settings,
     );
     let pilot_ms = pilot_start.elapsed().as_secs_f64() * 1e3;
@@ -179,6 +185,14 @@ pub fn build_lights(
         })
         .collect();
     structure.keep_buffers(&keep);
+    let eye = install_eye_buffer(
+        triangles,
+        &mut structure,
+        camera,
+        &pilot_camera,
+        size,
+        scale,
+    )?;
     let ms = start.elapsed().as_secs_f64() * 1e3;
     structure.set_build_ms(ms);
     let kept = structure.light_buffers().len();
@@ -190,18 +204,19 @@ pub fn build_lights(
             dropped: groups.len() - kept,
             skipped: groups.len() - chosen.len(),
             ms: pilot_ms,
+            eye,
         },
     ))
 }
 
 /// Node plus triangle tests.
-fn tests(s: &TraversalStats) -> u64 {
+pub(super) fn tests(s: &TraversalStats) -> u64 {
     u64::from(s.inner_nodes) + u64::from(s.triangles)
 }
 
 /// Whether `through_buffer` tests pay against `through_global` on the same segments. A buffer
 /// no pilot segment used has shown no saving: its light is rarely chosen, or unseen.
-fn pays(through_buffer: u64, through_global: u64) -> bool {
+pub(super) fn pays(through_buffer: u64, through_global: u64) -> bool {
     through_global > 0 && through_buffer as f64 <= f64::from(KEEP_RATIO) * through_global as f64
 }
 
@@ -245,7 +260,7 @@ pub const EXPECTED_SAVING: f64 = 0.5;
 /// that the choice is the same on every run. A light that few of the frame's paths sample (one
 /// of many lights, or a small frame) gets no buffer: with 40 point lights over Sponza at
 /// 512 x 512, 16 samples, 32 buffers took 2.8 s to build (29 kept) for a frame of 9.8 s.
-fn repays_build(global_tests: u64, scale: f64, triangles: usize) -> bool {
+pub(super) fn repays_build(global_tests: u64, scale: f64, triangles: usize) -> bool {
     global_tests as f64 * scale * EXPECTED_SAVING >= BUILD_TESTS_PER_TRIANGLE * triangles as f64
 }
 
@@ -291,6 +306,7 @@ pub fn prune_by_pilot(
         dropped: before - kept,
         skipped: 0,
         ms,
+        eye: EyeBufferReport::default(),
     })
 }
 
@@ -348,7 +364,7 @@ mod tests {
             LightSet::new(vec![point(Vec3::new(5.0, 9.0, 5.0))], &scene.triangles).unwrap();
         let size = pilot_size(64, 64);
         let (eye, at) = (Vec3::new(5.0, 5.0, 0.3), Vec3::new(5.0, 4.0, 10.0));
-        let camera = Camera::new(eye, at, Vec3::Y, 75.0, size.0, size.1).unwrap();
+        let camera = Camera::new(eye, at, Vec3::Y, 75.0, 64, 64).unwrap();
         let build = |spp: u64| {
             build_lights(&scene, &lights, 1, &camera, size, 7, 64 * 64 * spp)
                 .unwrap()

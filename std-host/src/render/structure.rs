@@ -1,10 +1,12 @@
 //! The acceleration structure the integrator traces through, chosen with `--structure`.
 //!
-//! Camera and bounce rays always go through the global BVH. Shadow rays go through the
-//! structure: with `global` the same BVH, with `lights` the light buffer of the ray's light when
-//! it has one, and the global BVH for every segment the buffer does not answer, with `thesis`
-//! the thesis's influence areas, octree and fallback ([`super::ThesisStructure`]). All answer every query
-//! exactly as the global BVH does, so the images are byte-identical. `lights` answers a batch of
+//! Bounce rays always go through the global BVH. Shadow rays go through the structure: with
+//! `global` the same BVH, with `lights` the light buffer of the ray's light when it has one, and
+//! the global BVH for every segment the buffer does not answer, with `thesis` the thesis's
+//! influence areas, octree and fallback ([`super::ThesisStructure`]). Camera rays go through
+//! `lights`'s eye buffer when it kept one ([`super::eye_buffer`]), through the global BVH
+//! otherwise. All answer every query exactly as the global BVH does, so the images are
+//! byte-identical. `lights` answers a batch of
 //! segments fastest cell by cell of its buffers ([`Structure::occluded_batch`]).
 
 use std::time::Instant;
@@ -28,7 +30,9 @@ pub enum StructureKind {
     Global,
     /// A light buffer per light (per cluster of emissive triangles), built from the lights
     /// automatically and kept where a pilot frame's shadow rays show that it pays
-    /// ([`super::pilot`]), with the global BVH for what a buffer does not answer.
+    /// ([`super::pilot`]), with the global BVH for what a buffer does not answer; and for the
+    /// camera rays the buffer of a spot light at the eye, its cone the view, where the pilot's
+    /// camera rays show that it pays ([`super::eye_buffer`]).
     Lights,
     /// The thesis's structure with influence areas made from the lights: six frustums around
     /// a point light, one along a spot, an oriented box in front of a quad light or an emissive
@@ -56,6 +60,9 @@ pub struct Structure {
     buffers: Vec<LightBuffer>,
     /// Per light (index into the renderer's lights), its buffer's index, or `NO_BUFFER`.
     buffer_of: Vec<u32>,
+    /// `lights`: a light buffer at the camera's eye, for the camera rays, when the pilot frame
+    /// showed that it pays ([`super::pilot`]).
+    eye: Option<LightBuffer>,
     /// The `thesis` structure, which owns the global BVH as its fallback (`global` is then
     /// empty: no second copy).
     thesis: Option<ThesisStructure>,
@@ -106,6 +113,7 @@ impl Structure {
             global,
             buffers,
             buffer_of,
+            eye: None,
             thesis,
             build_ms: start.elapsed().as_secs_f64() * 1e3,
             global_build_ms,
@@ -145,6 +153,17 @@ impl Structure {
     /// The `thesis` structure, when that is the kind built.
     pub fn thesis(&self) -> Option<&ThesisStructure> {
         self.thesis.as_ref()
+    }
+
+    /// The eye buffer of `lights`, when the pilot frame kept one ([`Structure::eye_buffer`]).
+    pub fn eye_buffer(&self) -> Option<&LightBuffer> {
+        self.eye.as_ref()
+    }
+
+    /// Makes `eye` (a light buffer at the camera's eye, see [`Structure::eye_buffer`]) answer
+    /// the camera rays.
+    pub(super) fn install_eye(&mut self, eye: Option<LightBuffer>) {
+        self.eye = eye;
     }
 
     /// The index of `light`'s buffer, if it has one.
@@ -191,11 +210,39 @@ impl Structure {
         self.build_ms += ms;
     }
 
-    /// The closest hit of a camera or bounce ray, with its triangle's first vertex and edges
-    /// from the leaf block that held it: always the global BVH.
+    /// The closest hit of a bounce ray, with its triangle's first vertex and edges from the leaf
+    /// block that held it: always the global BVH.
     #[inline]
     pub fn closest_hit(&self, ray: &Ray) -> Option<(Hit, TriangleEdges)> {
         self.global().closest_hit_edges(ray)
+    }
+
+    /// [`Structure::closest_hit`] for a camera ray: through the eye buffer's cell of the ray's
+    /// direction where `lights` kept one, through the global BVH otherwise. The same answer
+    /// either way, bit for bit.
+    #[inline]
+    pub fn closest_hit_camera(&self, ray: &Ray) -> Option<(Hit, TriangleEdges)> {
+        match self
+            .eye
+            .as_ref()
+            .and_then(|e| e.closest_hit_leaving(&self.global, ray))
+        {
+            Some(found) => found,
+            None => self.closest_hit(ray),
+        }
+    }
+
+    /// [`Structure::closest_hit_camera`], counting node and triangle tests in `stats` (the eye
+    /// buffer's cell lookup counts as one inner node).
+    pub fn closest_hit_camera_counted(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        let via_eye = self
+            .eye
+            .as_ref()
+            .and_then(|e| e.closest_hit_leaving_with_stats(&self.global, ray, stats));
+        match via_eye {
+            Some(found) => found.map(|(hit, _)| hit),
+            None => self.global.closest_hit_with_stats(ray, stats),
+        }
     }
 
     /// Whether anything blocks the shadow segment `ray` toward light `light`.

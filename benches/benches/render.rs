@@ -193,12 +193,11 @@ impl Loaded {
                 b += 1;
             }
         }
-        let camera_rays = camera.clone();
         (
             frame.shadow_rays,
             frame.shadow_batches,
             closest,
-            camera_rays,
+            frame.recorded.camera,
         )
     }
 }

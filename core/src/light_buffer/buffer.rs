@@ -241,11 +241,12 @@ impl LightBuffer {
 
     /// The finest grid cell that answers `ray` as a ray leaving the source: it starts on the
     /// light (its origin within the light's box grown by the buffer's margin, where the shadow
-    /// segments it answers may end), and the cell is that of its direction. `None` for any other ray, or a `scene` of
-    /// another size. A cell's tree holds every triangle a segment of its directions can cross
-    /// from anywhere on the light, so it holds every triangle such a ray can hit, however far:
-    /// the buffer of a point light placed at a pinhole camera's eye answers the camera's rays
-    /// (the item buffer of Weghorst, Hooper and Greenberg 1984, made exact).
+    /// segments it answers may end), and the cell is that of its direction. `None` for any
+    /// other ray, or a `scene` of another size. A cell's tree holds every triangle a segment of
+    /// its directions can cross from anywhere on the light, so it holds every triangle such a
+    /// ray can hit, however far: the buffer of a point light placed at a pinhole camera's eye
+    /// answers the camera's rays (the item buffer of Weghorst, Hooper and Greenberg 1984, made
+    /// exact).
     #[inline]
     pub fn cell_leaving(&self, scene: &WideBvh8, ray: &Ray) -> Option<u32> {
         let (lo, hi) = self.end_box;

@@ -108,12 +108,13 @@ impl Camera {
 
     /// The cone every ray of [`Camera::ray`] leaves the eye in: its unit axis (the viewing
     /// direction) and its half-angle in radians, the angle to the image's corners, widened by
-    /// 1 % so that rounding leaves no ray outside. At most a right angle.
+    /// 1 % so that rounding leaves no ray outside. At least 1e-6 (a field of view so narrow that
+    /// its tangent rounds to zero still has a cone) and at most a right angle.
     pub fn view_cone(&self) -> (Vec3, f32) {
         let corner = (self.right + self.up).length().atan();
         (
             self.forward,
-            (corner * 1.01).min(core::f32::consts::FRAC_PI_2),
+            (corner * 1.01).clamp(1e-6, core::f32::consts::FRAC_PI_2),
         )
     }
 
@@ -204,6 +205,7 @@ mod tests {
             (75.0, 640, 360),
             (170.0, 3, 900),
             (1.0, 1, 1),
+            (1e-45, 4, 4),
         ] {
             let big = Camera::new(eye, at, Vec3::Y, fov, w, h).unwrap();
             let (pw, ph) = ((w / 8).max(1), (h / 8).max(1));
@@ -213,7 +215,8 @@ mod tests {
             assert!(half <= core::f32::consts::FRAC_PI_2);
             for (x, y) in [(0, 0), (w, 0), (0, h), (w, h), (w / 2, h / 3)] {
                 let d = big.ray(x as f32, y as f32).dir.normalize();
-                assert!(d.dot(axis).acos() < half, "{fov} {w} {h}: corner {x},{y}");
+                let angle = d.dot(axis).min(1.0).acos();
+                assert!(angle < half, "{fov} {w} {h}: corner {x},{y}");
             }
         }
     }

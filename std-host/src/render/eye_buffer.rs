@@ -43,16 +43,21 @@ pub(super) fn install_eye_buffer(
         .flat_map(|y| (0..width).map(move |x| (x, y)))
         .map(|(x, y)| pilot.ray(x as f32 + 0.5, y as f32 + 0.5))
         .collect();
-    let through = |s: &Structure| -> u64 {
+    // Node + triangle tests of the pilot's camera rays, through the eye buffer or the global BVH.
+    let through = |s: &Structure, eye: bool| -> u64 {
         rays.par_iter()
             .map(|ray| {
                 let mut stats = TraversalStats::default();
-                s.closest_hit_camera_counted(ray, &mut stats);
+                if eye {
+                    s.closest_hit_camera_counted(ray, &mut stats);
+                } else {
+                    s.global().closest_hit_with_stats(ray, &mut stats);
+                }
                 tests(&stats)
             })
             .sum()
     };
-    let global_tests = through(structure);
+    let global_tests = through(structure, false);
     if !repays_build(global_tests, scale, triangles.len()) {
         return Ok(EyeBufferReport::default());
     }
@@ -61,7 +66,7 @@ pub(super) fn install_eye_buffer(
         structure.global(),
         camera,
     )?));
-    let eye_tests = through(structure);
+    let eye_tests = through(structure, true);
     let kept = pays(eye_tests, global_tests);
     if !kept {
         structure.install_eye(None);

@@ -93,14 +93,14 @@ fn decide(
 }
 
 /// The `lights` structure built with the pilot frame deciding first: the global BVH, the pilot
-/// frame of the frame's `camera` (made at [`pilot_size`], `size`) traced through it, then a
-/// buffer built only
-/// for the light groups whose pilot segments leave it a chance to pay
-/// ([`MAX_EXTENT_RATIO`]) in a frame of `frame_samples` samples ([`BUILD_TESTS_PER_TRIANGLE`]), and of those
-/// kept only the ones that need at most [`KEEP_RATIO`] of the global BVH's tests on the same
-/// segments. The pilot's segments do not depend on the structure (every structure answers
-/// alike), so one pilot serves both decisions. Last, the eye buffer for the camera rays, decided
-/// by the pilot camera's rays in the same way ([`super::eye_buffer`]).
+/// frame (the frame's `camera` made at [`pilot_size`], `size`, by [`Camera::resized`]) traced
+/// through it, then a buffer built only for the light groups whose pilot segments leave it a
+/// chance to pay ([`MAX_EXTENT_RATIO`]) in a frame of `frame_samples` samples
+/// ([`BUILD_TESTS_PER_TRIANGLE`]), and of those kept only the ones that need at most
+/// [`KEEP_RATIO`] of the global BVH's tests on the same segments. The pilot's segments do not
+/// depend on the structure (every structure answers alike), so one pilot serves both decisions.
+/// Last, the eye buffer for the camera rays, decided by the pilot camera's rays in the same way
+/// ([`super::eye_buffer`]).
 pub fn build_lights(
     scene: &Scene,
     lights: &LightSet,

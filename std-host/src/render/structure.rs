@@ -155,7 +155,7 @@ impl Structure {
         self.thesis.as_ref()
     }
 
-    /// The eye buffer of `lights`, when the pilot frame kept one ([`Structure::eye_buffer`]).
+    /// The eye buffer of `lights`, when the pilot frame kept one ([`super::eye_buffer`]).
     pub fn eye_buffer(&self) -> Option<&LightBuffer> {
         self.eye.as_ref()
     }

@@ -227,14 +227,25 @@ impl LightBuffer {
         ray: &Ray,
         stats: &mut impl Counters,
     ) -> Option<bool> {
+        Some(match self.tree(cell, stats)? {
+            None => false,
+            Some((forest, root)) => forest.any_hit_from(root, &scene.tris, ray, stats),
+        })
+    }
+
+    /// Cell `cell`'s tree, the lookup counted as one inner node: its face's forest and its root,
+    /// `Some(None)` for a cell that reaches no triangle, `None` for a dark cell or one out of
+    /// range (not the buffer's to answer).
+    #[inline(always)]
+    fn tree(&self, cell: u32, stats: &mut impl Counters) -> Option<Option<(&WideBvh8, u32)>> {
         stats.node();
         match *self.grid.get(cell as usize)? {
             DARK => None,
-            CLEAR => Some(false),
+            CLEAR => Some(None),
             root => {
                 // The cell's face: its index over `r * r`, a power of two.
                 let face = cell >> (2 * self.resolution.trailing_zeros());
-                Some(self.forests[face as usize].any_hit_from(root, &scene.tris, ray, stats))
+                Some(Some((&self.forests[face as usize], root)))
             }
         }
     }
@@ -292,23 +303,14 @@ impl LightBuffer {
         stats: &mut impl Counters,
     ) -> Option<Option<(Hit, TriangleEdges)>> {
         let cell = self.cell_leaving(scene, ray)?;
-        stats.node();
-        match *self.grid.get(cell as usize)? {
-            DARK => None,
-            CLEAR => Some(None),
-            root => {
-                let face = cell >> (2 * self.resolution.trailing_zeros());
+        Some(match self.tree(cell, stats)? {
+            None => None,
+            Some((forest, root)) => {
                 let mut visitor = ClosestHitEdges::new(ray);
-                self.forests[face as usize].traverse_in(
-                    root,
-                    &scene.tris,
-                    ray,
-                    &mut visitor,
-                    stats,
-                );
-                Some(visitor.best)
+                forest.traverse_in(root, &scene.tris, ray, &mut visitor, stats);
+                visitor.best
             }
-        }
+        })
     }
 
     /// The finest grid cell of direction `d` (finite and non-zero, as a ray's direction is).
